@@ -1,0 +1,7 @@
+"""``python -m scenegrep``."""
+
+import sys
+
+from .cli.main import main
+
+sys.exit(main())

@@ -1,0 +1,56 @@
+"""User-facing errors.
+
+A :class:`UserError` is a mistake in what the user gave scenegrep (a file, a
+query, an option), as opposed to a bug in scenegrep. The command line prints
+it as one line, ``scenegrep: error: PLACE: MESSAGE``, and exits with code 2;
+it never shows a traceback for it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from os import PathLike
+
+
+@dataclass(frozen=True)
+class SourceLocation:
+    """A place in a user's input: a file (or ``<stdin>``, ``<query>``), optionally a
+    1-based line and column, optionally a path inside a structured document
+    (``frames[3].samples[0].image``)."""
+
+    source: str
+    line: int | None = None
+    column: int | None = None
+    path: str | None = None
+
+    def __str__(self) -> str:
+        text = self.source
+        if self.line is not None:
+            text += f":{self.line}"
+            if self.column is not None:
+                text += f":{self.column}"
+        if self.path:
+            text += f": {self.path}"
+        return text
+
+
+class UserError(Exception):
+    """An error in the user's input, reported as one line with its location."""
+
+    def __init__(self, message: str, location: SourceLocation | None = None, detail: str | None = None):
+        self.message = message
+        self.location = location
+        self.detail = detail
+        super().__init__(self.one_line())
+
+    def one_line(self) -> str:
+        """The message as the CLI prints it (without the ``scenegrep: error:`` prefix)."""
+        text = self.message if self.location is None else f"{self.location}: {self.message}"
+        return " ".join(text.split())
+
+
+def at(
+    source: str | PathLike[str], line: int | None = None, column: int | None = None, path: str | None = None
+) -> SourceLocation:
+    """Shorthand for a :class:`SourceLocation`."""
+    return SourceLocation(str(source), line, column, path)

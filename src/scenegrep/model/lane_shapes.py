@@ -1,0 +1,58 @@
+"""Lane shapes from centrelines and widths, for maps that give lanes as centrelines."""
+
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike
+from shapely.geometry.base import BaseGeometry
+
+
+def resample_polyline(line: np.ndarray, n: int) -> np.ndarray:
+    """``n`` points (n x 2) evenly spaced by arc length along a polyline (k x 2)."""
+    geom = shapely.linestrings(line)
+    return shapely.get_coordinates(shapely.line_interpolate_point(geom, np.linspace(0.0, 1.0, n), normalized=True))
+
+
+def _normals(centreline: np.ndarray) -> np.ndarray:
+    """Unit vectors pointing left of the direction of travel at each centreline point."""
+    tangent = np.gradient(centreline, axis=0) if len(centreline) > 1 else np.array([[0.0, 1.0]])
+    norm = np.linalg.norm(tangent, axis=1, keepdims=True)
+    tangent = np.divide(tangent, norm, out=np.zeros_like(tangent), where=norm > 0)
+    return np.stack([-tangent[:, 1], tangent[:, 0]], axis=1)
+
+
+def lane_polygon(centreline: np.ndarray, left_width: ArrayLike, right_width: ArrayLike) -> BaseGeometry:
+    """The polygon between the centreline offset ``left_width`` metres to its left and
+    ``right_width`` metres to its right (scalars or one value per centreline point)."""
+    centre = np.asarray(centreline, dtype=np.float64)[:, :2]
+    left = np.broadcast_to(np.asarray(left_width, dtype=np.float64), len(centre))[:, None]
+    right = np.broadcast_to(np.asarray(right_width, dtype=np.float64), len(centre))[:, None]
+    normals = _normals(centre)
+    ring = np.vstack([centre + normals * left, (centre - normals * right)[::-1]])
+    return shapely.make_valid(shapely.Polygon(ring))
+
+
+def line_strings(lines: list[np.ndarray]) -> np.ndarray:
+    """An array of shapely LineStrings from polylines (k_i x 2 arrays) of different lengths."""
+    if not lines:
+        return np.array([], dtype=object)
+    coords = np.concatenate([np.asarray(line, dtype=np.float64)[:, :2] for line in lines])
+    indices = np.repeat(np.arange(len(lines)), [len(line) for line in lines])
+    return shapely.linestrings(coords, indices=indices)
+
+
+def remove_backtracks(line: np.ndarray) -> np.ndarray:
+    """The polyline without the vertices where it doubles back (a segment pointing against the
+    one before it), as stitched map geometry sometimes does for a few centimetres; repeated
+    until no segment reverses. The end points are kept."""
+    points = np.asarray(line, dtype=np.float64)
+    while len(points) > 2:
+        step = np.diff(points, axis=0)
+        reverse = np.flatnonzero(np.einsum("ij,ij->i", step[1:], step[:-1]) <= 0) + 1
+        if len(reverse) == 0:
+            break
+        keep = np.ones(len(points), dtype=bool)
+        keep[reverse[0]] = False
+        points = points[keep]
+    return points

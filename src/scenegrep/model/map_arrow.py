@@ -1,0 +1,128 @@
+"""A road map as one Arrow table (scenegrep's Parquet map files and map cache).
+
+One row per map element; ``kind`` is lane, road, intersection, crosswalk,
+sidewalk, curb or drivable. Geometries are WKB (polygons; a curb is a line
+string); lanes also carry their centreline and topology columns.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pyarrow as pa
+import shapely
+
+from .roadmap import Area, Lane, LaneNeighbour, RoadMap
+
+METADATA_KEY = b"scenegrep-map"
+LAYOUT_VERSION = 1
+_AREA_KINDS = ("road", "intersection", "crosswalk", "sidewalk")
+_AREA_FIELDS = ("roads", "intersections", "crosswalks", "sidewalks")
+
+SCHEMA = pa.schema(
+    [
+        ("kind", pa.string()),
+        ("id", pa.string()),
+        ("geometry", pa.binary()),
+        ("centreline", pa.binary()),
+        ("road", pa.string()),
+        ("is_intersection", pa.bool_()),
+        ("successors", pa.list_(pa.string())),
+        ("predecessors", pa.list_(pa.string())),
+        ("left", pa.string()),
+        ("left_same_direction", pa.bool_()),
+        ("right", pa.string()),
+        ("right_same_direction", pa.bool_()),
+        ("lane_kind", pa.string()),
+        ("speed_limit", pa.float64()),
+        ("lanes", pa.list_(pa.string())),
+    ]
+)
+
+
+def _lane_row(lane: Lane) -> dict:
+    return {
+        "kind": "lane",
+        "id": lane.id,
+        "geometry": shapely.to_wkb(lane.polygon),
+        "centreline": shapely.to_wkb(shapely.linestrings(lane.centreline)),
+        "road": lane.road,
+        "is_intersection": lane.is_intersection,
+        "successors": list(lane.successors),
+        "predecessors": list(lane.predecessors),
+        "left": lane.left.lane if lane.left else None,
+        "left_same_direction": lane.left.same_direction if lane.left else None,
+        "right": lane.right.lane if lane.right else None,
+        "right_same_direction": lane.right.same_direction if lane.right else None,
+        "lane_kind": lane.kind,
+        "speed_limit": lane.speed_limit,
+    }
+
+
+def map_to_table(road_map: RoadMap) -> pa.Table:
+    """The map as an Arrow table with the :data:`SCHEMA`."""
+    rows = [_lane_row(lane) for lane in road_map.lanes]
+    for kind, name in zip(_AREA_KINDS, _AREA_FIELDS):
+        rows += [
+            {"kind": kind, "id": a.id, "geometry": shapely.to_wkb(a.polygon), "lanes": list(a.lanes)}
+            for a in getattr(road_map, name)
+        ]
+    rows += [
+        {"kind": "curb", "id": str(i), "geometry": shapely.to_wkb(shapely.linestrings(c))}
+        for i, c in enumerate(road_map.curbs)
+    ]
+    if road_map.drivable_area is not None:
+        rows.append({"kind": "drivable", "id": "drivable", "geometry": shapely.to_wkb(road_map.drivable_area)})
+    table = pa.Table.from_pylist(rows, schema=SCHEMA)
+    meta = {"layout": LAYOUT_VERSION, "name": road_map.name, "source": road_map.source}
+    return table.replace_schema_metadata({METADATA_KEY: json.dumps(meta).encode()})
+
+
+def is_map_table(schema: pa.Schema) -> bool:
+    """Whether an Arrow schema carries scenegrep map metadata."""
+    return bool(schema.metadata) and METADATA_KEY in schema.metadata
+
+
+def _neighbour(lane: str | None, same: bool | None) -> LaneNeighbour | None:
+    return None if lane is None else LaneNeighbour(lane, bool(same))
+
+
+def map_from_table(table: pa.Table) -> RoadMap:
+    """Rebuild a map from a table written by :func:`map_to_table`; ValueError if it is not one."""
+    if not is_map_table(table.schema):
+        raise ValueError("not a scenegrep map table (no scenegrep-map metadata)")
+    meta = json.loads(table.schema.metadata[METADATA_KEY])
+    if meta.get("layout") != LAYOUT_VERSION:
+        raise ValueError(f"unsupported map layout {meta.get('layout')!r}")
+    rows = table.to_pylist()
+    geometry = shapely.from_wkb(np.array([r["geometry"] for r in rows], dtype=object))
+    lanes, areas, curbs, drivable = [], {k: [] for k in _AREA_KINDS}, [], None
+    for row, geom in zip(rows, geometry):
+        kind = row["kind"]
+        if kind == "lane":
+            centre = shapely.get_coordinates(shapely.from_wkb(row["centreline"]))
+            lanes.append(
+                Lane(
+                    row["id"],
+                    geom,
+                    centre,
+                    row["road"],
+                    bool(row["is_intersection"]),
+                    tuple(row["successors"] or ()),
+                    tuple(row["predecessors"] or ()),
+                    _neighbour(row["left"], row["left_same_direction"]),
+                    _neighbour(row["right"], row["right_same_direction"]),
+                    row["lane_kind"],
+                    row["speed_limit"],
+                )
+            )
+        elif kind in areas:
+            areas[kind].append(Area(row["id"], geom, tuple(row["lanes"] or ())))
+        elif kind == "curb":
+            curbs.append(shapely.get_coordinates(geom))
+        elif kind == "drivable":
+            drivable = geom
+    return RoadMap(
+        meta["name"], tuple(lanes), *(tuple(areas[k]) for k in _AREA_KINDS), tuple(curbs), drivable, meta.get("source")
+    )

@@ -1,0 +1,271 @@
+"""The road map: lanes with topology, roads, intersections, crosswalks, sidewalks,
+curbs and drivable area, with vectorised point queries over R-trees.
+
+Coordinates are metres in the map frame of the traces that use it; directions
+are Scenic headings (see :mod:`scenegrep.model.geometry`). A lane's centreline
+runs in its direction of travel. Point queries take arrays of x and y and answer
+for all points at once; the R-trees (shapely STRtrees) are built on first use.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from collections.abc import Iterable
+
+import numpy as np
+import shapely
+from shapely import STRtree
+from shapely.geometry.base import BaseGeometry
+
+from .geometry import heading_difference, heading_of_vector
+from .lane_shapes import line_strings
+
+_TANGENT_STEP_M = 0.5
+"""Half the chord (m) used to measure a centreline's direction at a point."""
+
+
+@dataclass(frozen=True)
+class LaneNeighbour:
+    """An adjacent lane and whether its traffic runs the same way."""
+
+    lane: str
+    same_direction: bool
+
+
+@dataclass(frozen=True, eq=False)
+class Lane:
+    """A lane: polygon, centreline (k x 2, in travel direction) and topology.
+
+    ``kind`` is ``vehicle``, ``bike`` or ``bus``; ``speed_limit`` is in m/s when known.
+    """
+
+    id: str
+    polygon: BaseGeometry
+    centreline: np.ndarray
+    road: str | None = None
+    is_intersection: bool = False
+    successors: tuple[str, ...] = ()
+    predecessors: tuple[str, ...] = ()
+    left: LaneNeighbour | None = None
+    right: LaneNeighbour | None = None
+    kind: str = "vehicle"
+    speed_limit: float | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Area:
+    """A polygonal map element (road, intersection, crosswalk, sidewalk) and the lanes it holds."""
+
+    id: str
+    polygon: BaseGeometry
+    lanes: tuple[str, ...] = ()
+
+
+REGION_NAMES = ("lane", "road", "intersection", "crossing", "sidewalk", "drivable")
+"""Region names accepted by :meth:`RoadMap.contains`; Scenic's driving-domain names."""
+
+
+@dataclass(frozen=True, eq=False)
+class RoadMap:
+    """A road network; see the module docstring. ``curbs`` are polylines (k x 2 arrays)."""
+
+    name: str
+    lanes: tuple[Lane, ...]
+    roads: tuple[Area, ...] = ()
+    intersections: tuple[Area, ...] = ()
+    crosswalks: tuple[Area, ...] = ()
+    sidewalks: tuple[Area, ...] = ()
+    curbs: tuple[np.ndarray, ...] = ()
+    drivable_area: BaseGeometry | None = None
+    source: str | None = field(default=None, compare=False)
+
+    # ------------------------------------------------------------------ lookup tables
+    @cached_property
+    def lane_index(self) -> dict[str, int]:
+        """Lane id -> position in :attr:`lanes`."""
+        return {lane.id: i for i, lane in enumerate(self.lanes)}
+
+    @cached_property
+    def lane_polygons(self) -> np.ndarray:
+        return np.array([lane.polygon for lane in self.lanes], dtype=object)
+
+    @cached_property
+    def lane_centrelines(self) -> np.ndarray:
+        return line_strings([lane.centreline for lane in self.lanes])
+
+    @cached_property
+    def lane_is_intersection(self) -> np.ndarray:
+        return np.array([lane.is_intersection for lane in self.lanes], dtype=bool)
+
+    @cached_property
+    def _lane_tree(self) -> STRtree:
+        return STRtree(self.lane_polygons)
+
+    @cached_property
+    def _region_trees(self) -> dict[str, STRtree]:
+        groups = {
+            "road": [a.polygon for a in self.roads],
+            "intersection": [a.polygon for a in self.intersections],
+            "crossing": [a.polygon for a in self.crosswalks],
+            "sidewalk": [a.polygon for a in self.sidewalks],
+            "drivable": [self.drivable] if not self.drivable.is_empty else [],
+        }
+        return {name: STRtree(np.array(geoms, dtype=object)) for name, geoms in groups.items()}
+
+    @cached_property
+    def drivable(self) -> BaseGeometry:
+        """The drivable area; the union of the lane polygons when the map gives none."""
+        if self.drivable_area is not None:
+            return self.drivable_area
+        return shapely.union_all(self.lane_polygons) if self.lanes else shapely.Polygon()
+
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(min x, min y, max x, max y) of all lanes and areas, in metres."""
+        geoms = list(self.lane_polygons) + [
+            a.polygon for a in self.roads + self.intersections + self.crosswalks + self.sidewalks
+        ]
+        return tuple(shapely.total_bounds(np.array(geoms, dtype=object)).tolist())  # type: ignore[return-value]
+
+    # ------------------------------------------------------------------ point queries
+    def lanes_containing(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """All (point, lane) pairs where point i lies in lane j (boundary included).
+
+        Returns two int arrays (point indices, lane indices), sorted by point.
+        """
+        points = shapely.points(np.atleast_1d(x), np.atleast_1d(y))
+        if not self.lanes:
+            return np.zeros(0, np.intp), np.zeros(0, np.intp)
+        point_idx, lane_idx = self._lane_tree.query(points, predicate="intersects")
+        order = np.lexsort((lane_idx, point_idx))
+        return point_idx[order], lane_idx[order]
+
+    def lane_at(self, x: np.ndarray, y: np.ndarray, heading: np.ndarray | None = None) -> np.ndarray:
+        """Index of the lane each point is in (-1 for none).
+
+        Where lanes overlap (intersections), the lane whose direction at the point is
+        closest to ``heading`` (radians) wins when a heading is given, else the lane
+        whose centreline is nearest.
+        """
+        x, y = np.atleast_1d(np.asarray(x, dtype=float)), np.atleast_1d(np.asarray(y, dtype=float))
+        result = np.full(len(x), -1, dtype=np.intp)
+        point_idx, lane_idx = self.lanes_containing(x, y)
+        if len(point_idx) == 0:
+            return result
+        if heading is None:
+            cost = shapely.distance(self.lane_centrelines[lane_idx], shapely.points(x[point_idx], y[point_idx]))
+        else:
+            directions = self._directions(lane_idx, x[point_idx], y[point_idx])
+            cost = np.abs(heading_difference(np.atleast_1d(heading)[point_idx], directions))
+        order = np.lexsort((cost, point_idx))
+        first = np.ones(len(order), dtype=bool)
+        first[1:] = point_idx[order][1:] != point_idx[order][:-1]
+        result[point_idx[order][first]] = lane_idx[order][first]
+        return result
+
+    def lane_direction_at(self, x: np.ndarray, y: np.ndarray, lane: np.ndarray | None = None) -> np.ndarray:
+        """Direction of travel (heading, radians) at each point: the tangent of the centreline
+        of ``lane`` (or of the lane found by :meth:`lane_at`) at the point's projection; NaN off-lane."""
+        x, y = np.atleast_1d(np.asarray(x, dtype=float)), np.atleast_1d(np.asarray(y, dtype=float))
+        lane = self.lane_at(x, y) if lane is None else np.atleast_1d(lane)
+        out = np.full(len(x), np.nan)
+        on = lane >= 0
+        out[on] = self._directions(lane[on], x[on], y[on])
+        return out
+
+    def nominal_directions_at(self, x: float, y: float) -> list[float]:
+        """Headings of every lane containing the point (several inside intersections)."""
+        _, lanes = self.lanes_containing(np.array([x]), np.array([y]))
+        return self._directions(lanes, np.full(len(lanes), x), np.full(len(lanes), y)).tolist()
+
+    def in_intersection(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Whether each point lies in an intersection area or in an intersection lane."""
+        inside = self.contains("intersection", x, y)
+        point_idx, lane_idx = self.lanes_containing(x, y)
+        inside[point_idx[self.lane_is_intersection[lane_idx]]] = True
+        return inside
+
+    def contains(self, region: str, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Whether each point lies in the named region (one of :data:`REGION_NAMES`), boundary included."""
+        x, y = np.atleast_1d(np.asarray(x, dtype=float)), np.atleast_1d(np.asarray(y, dtype=float))
+        inside = np.zeros(len(x), dtype=bool)
+        if region == "lane":
+            inside[self.lanes_containing(x, y)[0]] = True
+            return inside
+        if region not in self._region_trees:
+            raise KeyError(f"unknown map region {region!r}; known: {', '.join(REGION_NAMES)}")
+        tree = self._region_trees[region]
+        if len(tree.geometries):
+            inside[tree.query(shapely.points(x, y), predicate="intersects")[0]] = True
+        return inside
+
+    def _directions(self, lane_idx: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        lines = self.lane_centrelines[lane_idx]
+        s = shapely.line_locate_point(lines, shapely.points(x, y))
+        length = shapely.length(lines)
+        a = shapely.line_interpolate_point(lines, np.clip(s - _TANGENT_STEP_M, 0, length))
+        b = shapely.line_interpolate_point(lines, np.clip(s + _TANGENT_STEP_M, 0, length))
+        return heading_of_vector(shapely.get_x(b) - shapely.get_x(a), shapely.get_y(b) - shapely.get_y(a))
+
+    # ------------------------------------------------------------------ comparison
+    def equals(self, other: object) -> bool:
+        """Element-by-element equality with exactly equal coordinates."""
+        if not isinstance(other, RoadMap) or self.name != other.name:
+            return False
+        pairs = [
+            (self.lanes, other.lanes),
+            (self.roads, other.roads),
+            (self.intersections, other.intersections),
+            (self.crosswalks, other.crosswalks),
+            (self.sidewalks, other.sidewalks),
+        ]
+        if any(len(a) != len(b) for a, b in pairs) or len(self.curbs) != len(other.curbs):
+            return False
+        if not all(_same_element(x, y) for a, b in pairs for x, y in zip(a, b)):
+            return False
+        if not all(np.array_equal(a, b) for a, b in zip(self.curbs, other.curbs)):
+            return False
+        if (self.drivable_area is None) != (other.drivable_area is None):
+            return False
+        return self.drivable_area is None or bool(shapely.equals_exact(self.drivable_area, other.drivable_area, 0.0))
+
+    # ------------------------------------------------------------------ cropping
+    def crop(self, x: float, y: float, radius: float) -> RoadMap:
+        """The elements within ``radius`` metres of (x, y); topology links to dropped lanes are kept
+        as ids, so a cropped lane still names its successors."""
+        disc = shapely.Point(x, y).buffer(radius)
+
+        def near(items: Iterable[Area]) -> tuple[Area, ...]:
+            return tuple(a for a in items if a.polygon.intersects(disc))
+
+        lanes = tuple(self.lanes[i] for i in self._lane_tree.query(disc, predicate="intersects").tolist())
+        lanes = tuple(sorted(lanes, key=lambda lane: self.lane_index[lane.id]))
+        curbs = tuple(c for c in self.curbs if shapely.linestrings(c).intersects(disc))
+        drivable = None if self.drivable_area is None else self.drivable_area.intersection(disc)
+        return RoadMap(
+            self.name,
+            lanes,
+            near(self.roads),
+            near(self.intersections),
+            near(self.crosswalks),
+            near(self.sidewalks),
+            curbs,
+            drivable,
+            self.source,
+        )
+
+
+def _same_element(a: Lane | Area, b: Lane | Area) -> bool:
+    """Equality of two lanes or two areas: fields equal, geometry coordinates exactly equal."""
+    if type(a) is not type(b) or not shapely.equals_exact(a.polygon, b.polygon, 0.0):
+        return False
+    for name in a.__dataclass_fields__:
+        mine, theirs = getattr(a, name), getattr(b, name)
+        if name == "polygon":
+            continue
+        if isinstance(mine, np.ndarray):
+            if not np.array_equal(mine, theirs):
+                return False
+        elif mine != theirs:
+            return False
+    return True

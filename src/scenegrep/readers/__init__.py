@@ -1,0 +1,164 @@
+"""Readers: every supported input format turned into the data model.
+
+Each format lives in its own module of this package, loaded only when needed
+(so ``scenegrep --help`` and SpRE runs never import Scenic or shapely). A module
+offers some of:
+
+- ``read_traces(path) -> Iterator[LabelTrace]`` for files holding several traces, or
+  ``read_trace(path) -> LabelTrace`` for files holding one;
+- ``read_map(path, key=None) -> RoadMap`` for formats that carry a road map.
+
+:func:`detect_format` names the format of a path; :func:`read_traces`,
+:func:`read_trace` and :func:`read_map` dispatch to the module.
+"""
+
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from types import ModuleType
+from collections.abc import Iterator
+
+from ..errors import UserError, at
+from ..model import LabelTrace, MapSource, RoadMap
+
+
+@dataclass(frozen=True)
+class Format:
+    """A supported input format: its name, module, and what it holds."""
+
+    name: str
+    module: str
+    description: str
+    traces: bool
+    map: bool
+
+
+FORMATS: dict[str, Format] = {
+    f.name: f
+    for f in (
+        Format(
+            "strem-json",
+            "strem_json",
+            "STREM JSON v0.2.0 perception stream (several documents allowed; - for stdin)",
+            True,
+            False,
+        ),
+        Format("scenegrep-json", "trace_json", "scenegrep JSON trace (hand-written fixtures)", True, False),
+        Format("scenegrep-parquet", "trace_parquet", "scenegrep Parquet trace", True, False),
+        Format("scenegrep-map-parquet", "trace_parquet", "scenegrep Parquet road map", False, True),
+        Format("av2-sensor", "av2_sensor", "Argoverse 2 sensor log directory (annotations + poses + map)", True, False),
+        Format(
+            "av2-forecasting", "av2_forecasting", "Argoverse 2 motion-forecasting scenario (parquet + map)", True, False
+        ),
+        Format("av2-map", "av2_map", "Argoverse 2 vector map JSON", False, True),
+        Format(
+            "scenarionet", "scenarionet", "ScenarioNet pickle (nuScenes, Waymo, ...), restricted unpickling", True, True
+        ),
+        Format("waymo-tfrecord", "waymo_tfrecord", "Waymo Open Motion Scenario TFRecord", True, True),
+        Format("commonroad", "commonroad", "CommonRoad 2018b/2020a scenario XML", True, True),
+        Format("opendrive", "opendrive", "OpenDRIVE road network (.xodr) through Scenic", False, True),
+    )
+}
+
+
+def module(format_name: str) -> ModuleType:
+    """The reader module of a format."""
+    return importlib.import_module(f"{__name__}.{FORMATS[format_name].module}")
+
+
+def _sniff_json(path: Path) -> str | None:
+    with open(path, "rb") as handle:
+        head = handle.read(4096)
+    if b'"scenegrep"' in head and b'"trace"' in head:
+        return "scenegrep-json"
+    if b'"lane_segments"' in head or b'"drivable_areas"' in head or b'"pedestrian_crossings"' in head:
+        return "av2-map"
+    if b'"frames"' in head or b'"version"' in head:
+        return "strem-json"
+    return None
+
+
+def _sniff_file(path: Path) -> str | None:
+    suffix = path.suffix.lower()
+    if suffix == ".json":
+        return _sniff_json(path)
+    if suffix == ".parquet":
+        if path.name.startswith("scenario_"):
+            return "av2-forecasting"
+        kind = module("scenegrep-parquet").kind(path)
+        return {"trace": "scenegrep-parquet", "map": "scenegrep-map-parquet"}.get(kind or "")
+    if suffix == ".feather" and path.name == "annotations.feather":
+        return "av2-sensor"
+    simple = {".pkl": "scenarionet", ".pickle": "scenarionet", ".xodr": "opendrive", ".xml": "commonroad"}
+    if suffix in simple:
+        return simple[suffix]
+    if suffix == ".tfrecord" or ".tfrecord-" in path.name:
+        return "waymo-tfrecord"
+    return None
+
+
+def detect_format(path: str | Path) -> str:
+    """The format name of a path (``-`` is a STREM stream on stdin); UserError when unknown."""
+    if str(path) == "-":
+        return "strem-json"
+    path = Path(path)
+    if path.is_dir():
+        if (path / "annotations.feather").is_file() and (path / "city_SE3_egovehicle.feather").is_file():
+            return "av2-sensor"
+        if any(path.glob("scenario_*.parquet")):
+            return "av2-forecasting"
+        raise UserError("a directory that is not an Argoverse 2 log or scenario", at(path))
+    if not path.exists():
+        raise UserError("no such file or directory", at(path))
+    found = _sniff_file(path)
+    if found is None:
+        raise UserError(f"unrecognised input format; supported: {', '.join(FORMATS)}", at(path))
+    return found
+
+
+def _checked(path: str | Path, format_name: str | None, need: str) -> str:
+    name = format_name or detect_format(path)
+    if name not in FORMATS:
+        raise UserError(f"unknown format {name!r}; supported: {', '.join(FORMATS)}", at(path))
+    if not getattr(FORMATS[name], need):
+        raise UserError(
+            f"a {FORMATS[name].description} holds no {'label trace' if need == 'traces' else 'road map'}", at(path)
+        )
+    return name
+
+
+def read_traces(path: str | Path, format_name: str | None = None) -> Iterator[LabelTrace]:
+    """Every trace in a file or recording directory."""
+    reader = module(_checked(path, format_name, "traces"))
+    if hasattr(reader, "read_traces"):
+        yield from reader.read_traces(path)
+    else:
+        yield reader.read_trace(path)
+
+
+def read_trace(path: str | Path, format_name: str | None = None) -> LabelTrace:
+    """The one trace of a file or recording directory (UserError if it holds several)."""
+    traces = iter(read_traces(path, format_name))
+    first = next(traces, None)
+    if first is None:
+        raise UserError("holds no trace", at(path))
+    if next(traces, None) is not None:
+        raise UserError("holds several traces; read them with read_traces", at(path))
+    return first
+
+
+@lru_cache(maxsize=16)
+def _read_map_cached(path: str, format_name: str, key: str | None) -> RoadMap:
+    reader = module(format_name)
+    return reader.read_map(path) if key is None else reader.read_map(path, key)
+
+
+def read_map(source: MapSource | str | Path, format_name: str | None = None) -> RoadMap:
+    """A road map from a :class:`MapSource` or a path (maps are cached per process: a fleet
+    of traces usually shares a few city maps)."""
+    if isinstance(source, MapSource):
+        return _read_map_cached(source.path, _checked(source.path, source.format, "map"), source.key)
+    return _read_map_cached(str(source), _checked(source, format_name, "map"), None)

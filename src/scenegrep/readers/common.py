@@ -1,0 +1,55 @@
+"""Helpers shared by the readers: reading input files, turning failures into user errors."""
+
+from __future__ import annotations
+
+import contextlib
+from pathlib import Path
+from typing import Any
+from collections.abc import Iterator, Mapping
+
+from ..errors import UserError, at
+
+STDIN = "-"
+"""The path that means standard input."""
+
+
+def display_name(path: str | Path) -> str:
+    """How a path is named in messages (``<stdin>`` for ``-``)."""
+    return "<stdin>" if str(path) == STDIN else str(path)
+
+
+def read_bytes(path: str | Path) -> bytes:
+    """The whole content of a file; a missing or unreadable file is a :class:`UserError`."""
+    try:
+        return Path(path).read_bytes()
+    except FileNotFoundError:
+        raise UserError("no such file", at(path)) from None
+    except IsADirectoryError:
+        raise UserError("is a directory, expected a file", at(path)) from None
+    except OSError as exc:
+        raise UserError(f"cannot read: {exc.strerror}", at(path)) from None
+
+
+@contextlib.contextmanager
+def reading(path: str | Path, what: str, *errors: type[BaseException]) -> Iterator[None]:
+    """Turn the given library exceptions (and OSError) raised while reading ``path`` as
+    ``what`` (e.g. "an Argoverse 2 annotations file") into a one-line :class:`UserError`."""
+    try:
+        yield
+    except UserError:
+        raise
+    except FileNotFoundError as exc:
+        raise UserError(f"no such file: {exc.filename or path}", at(path)) from None
+    except (OSError, *errors) as exc:
+        detail = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise UserError(f"not a valid {what} (truncated or corrupt?): {detail}", at(path)) from None
+
+
+def field(mapping: Mapping[str, Any], key: str, path: str | Path, where: str) -> Any:
+    """``mapping[key]``, or a :class:`UserError` naming the missing field and where it was expected."""
+    if not isinstance(mapping, Mapping):
+        raise UserError(f"expected an object at {where}, found {type(mapping).__name__}", at(path))
+    try:
+        return mapping[key]
+    except KeyError:
+        raise UserError(f"missing field {key!r} in {where}", at(path)) from None

@@ -1,0 +1,45 @@
+"""Shared fixtures: where the real data is, and skipping when it is absent.
+
+Tests that read ``../shared/real_data`` or ``../shared/maps`` use the fixtures here;
+they skip with a message when the folder is absent (CI always has it, and
+``.ci/run`` fails without it).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, settings
+
+settings.register_profile("scenegrep", deadline=None, suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "scenegrep"))
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED = Path(os.environ.get("SCENEGREP_SHARED", REPO.parent / "shared"))
+
+
+def _folder(name: str) -> Path:
+    folder = SHARED / name
+    if not folder.is_dir():
+        pytest.skip(f"{folder} is absent: real-data tests need ../shared beside the repository")
+    return folder
+
+
+@pytest.fixture(scope="session")
+def real_data() -> Path:
+    """../shared/real_data (skips the test when absent)."""
+    return _folder("real_data")
+
+
+@pytest.fixture(scope="session")
+def maps_dir() -> Path:
+    """../shared/maps (skips the test when absent)."""
+    return _folder("maps")
+
+
+@pytest.fixture(scope="session")
+def conformance_dir() -> Path:
+    """../shared/conformance (skips the test when absent)."""
+    return _folder("conformance")

@@ -1,0 +1,103 @@
+"""LabelTrace: invariants, dense views, slicing by time and by object (against brute force)."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from scenegrep.model import BehaviourLabels, LabelTrace, ObjectTable, StateTable
+from tests.strategies import label_traces
+
+
+def small_trace() -> LabelTrace:
+    objects = ObjectTable.build(["a", "b"], ["car", "pedestrian"])
+    states = StateTable.build([1, 0, 0, 2], [0, 1, 0, 0], [1.0, 5.0, 0.0, 2.0], [0, 0, 0, 0], [0, 0, 0, 0])
+    labels = BehaviourLabels.from_sets([{"F"}, {"S"}, {"G"}, {"F", "L"}])
+    return LabelTrace.build("t", [10, 11, 12], [0.0, 0.1, 0.2], objects, states, behaviours=labels, ego="a")
+
+
+def test_build_sorts_states_and_labels_together():
+    t = small_trace()
+    assert t.states.frame.tolist() == [0, 0, 1, 2] and t.states.object.tolist() == [0, 1, 0, 0]
+    assert t.states.x.tolist() == [0.0, 5.0, 1.0, 2.0]
+    assert t.behaviours.sets() == [{"G"}, {"S"}, {"F"}, {"F", "L"}]
+
+
+def test_validate_rejects_duplicates_and_bad_codes():
+    objects = ObjectTable.build(["a"], ["car"])
+    with pytest.raises(ValueError, match="duplicates"):
+        LabelTrace.build("t", [0], [0.0], objects, StateTable.build([0, 0], [0, 0], [0, 0], [0, 0], [0, 0]))
+    with pytest.raises(ValueError, match="object out of range"):
+        LabelTrace.build("t", [0], [0.0], objects, StateTable.build([0], [1], [0], [0], [0]))
+    with pytest.raises(ValueError, match="ego"):
+        LabelTrace.build("t", [0], [0.0], objects, StateTable.build([0], [0], [0], [0], [0]), ego="zz")
+    with pytest.raises(ValueError, match="unique"):
+        ObjectTable.build(["a", "a"], ["car", "car"])
+
+
+def test_dense_and_present():
+    t = small_trace()
+    assert t.present().tolist() == [[True, True], [True, False], [True, False]]
+    x = t.dense("x")
+    assert x[0].tolist() == [0.0, 5.0] and np.isnan(x[1, 1])
+
+
+@given(label_traces(), st.integers(-2, 10), st.integers(-2, 10))
+def test_slice_frames_matches_brute_force(trace, start, stop):
+    sliced = trace.slice_frames(start, stop)
+    kept = list(range(trace.n_frames))[start:stop]
+    assert sliced.frame_index.tolist() == trace.frame_index[kept].tolist()
+    expected = {
+        (kept.index(f), trace.objects.id[o], x)
+        for f, o, x in zip(trace.states.frame, trace.states.object, trace.states.x)
+        if f in kept
+    }
+    got = {(f, sliced.objects.id[o], x) for f, o, x in zip(sliced.states.frame, sliced.states.object, sliced.states.x)}
+    assert got == expected
+    if trace.behaviours is not None:
+        before = {
+            (kept.index(f), trace.objects.id[o], s)
+            for f, o, s in zip(trace.states.frame, trace.states.object, trace.behaviours.sets())
+            if f in kept
+        }
+        after = set(zip(sliced.states.frame, sliced.objects.id[sliced.states.object], sliced.behaviours.sets()))
+        assert after == before
+    if trace.images is not None:
+        boxes_before = sorted(
+            (kept.index(trace.images.samples.frame[s]), x)
+            for s, x in zip(trace.images.boxes.sample, trace.images.boxes.cx)
+            if trace.images.samples.frame[s] in kept
+        )
+        boxes_after = sorted(zip(sliced.images.samples.frame[sliced.images.boxes.sample], sliced.images.boxes.cx))
+        assert boxes_after == boxes_before
+    sliced.validate()
+
+
+@given(label_traces(), st.floats(-0.5, 2.0), st.floats(0.0, 3.0))
+def test_between_keeps_frames_in_closed_interval(trace, t0, length):
+    sliced = trace.between(t0, t0 + length)
+    assert sliced.frame_time.tolist() == [t for t in trace.frame_time if t0 <= t <= t0 + length]
+
+
+@given(label_traces(), st.data())
+def test_select_objects(trace, data):
+    chosen = data.draw(st.lists(st.sampled_from(trace.objects.id.tolist()), unique=True)) if trace.n_objects else []
+    sub = trace.select_objects(chosen)
+    assert sorted(sub.objects.id.tolist()) == sorted(chosen)
+    assert sub.n_frames == trace.n_frames
+    expected = sorted(
+        (f, trace.objects.id[o])
+        for f, o in zip(trace.states.frame, trace.states.object)
+        if trace.objects.id[o] in chosen
+    )
+    assert sorted((f, sub.objects.id[o]) for f, o in zip(sub.states.frame, sub.states.object)) == expected
+
+
+def test_select_unknown_object_raises():
+    with pytest.raises(KeyError):
+        small_trace().select_objects(["nope"])
+
+
+def test_behaviour_threshold_keeps_unscored_labels():
+    labels = BehaviourLabels.from_sets([{"F": 0.9, "L": 0.2}, {"S": None}])
+    assert labels.thresholded(0.5).sets() == [{"F"}, {"S"}]

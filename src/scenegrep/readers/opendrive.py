@@ -1,0 +1,158 @@
+"""OpenDRIVE road networks (``.xodr``), read through Scenic's own road network.
+
+Scenic's :class:`scenic.domains.driving.roads.Network` parses the file (seconds
+for a CARLA town); the result is converted to the data model's
+:class:`~scenegrep.model.RoadMap` and cached as a Parquet map in the user cache
+(keyed by the file's SHA-256 and the Scenic version), so later loads take
+milliseconds and never import Scenic. Scenic's own ``.snet`` cache is not used:
+it would be written beside the map, which may be read-only.
+
+Scenic's centrelines sometimes double back for a few centimetres where OpenDRIVE
+geometry pieces overlap (168 vertices in Town01); those vertices are dropped
+(:func:`scenegrep.model.lane_shapes.remove_backtracks`), so directions along a lane are
+those of travel everywhere.
+
+Conversion (through the private accessors ``_successor``, ``_predecessor``, ``_laneToLeft``,
+``_laneToRight``, which return None where the public ones reject): every Scenic lane is
+a lane (id = Scenic uid such as ``road40_lane1``; lanes of connecting roads are
+intersection lanes). Successors are the lane's
+Scenic successor plus the connecting lanes of its maneuvers; predecessors are
+the inverse links. A lane's left/right neighbour is that of its first lane
+section having one, with same direction when both sections run the same way.
+Roads, intersections (holding their maneuvers' connecting lanes), crossings,
+sidewalks, the curbs of ordinary roads and the drivable region come over as they
+are in Scenic.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import warnings
+import xml.etree.ElementTree as ElementTree
+from dataclasses import replace
+from importlib.metadata import version
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..cache import cache_dir, file_digest
+from ..errors import UserError, at
+from ..model import Area, Lane, LaneNeighbour, RoadMap
+from ..model.lane_shapes import remove_backtracks
+from ..writers.trace_parquet import write_map_parquet
+from .common import reading
+from .trace_parquet import read_map as read_cached
+
+FORMAT = "opendrive"
+
+
+def _neighbour(lane: Any, side: str) -> LaneNeighbour | None:
+    for section in lane.sections:
+        other = getattr(section, f"_laneTo{side}")
+        if other is not None:
+            return LaneNeighbour(other.lane.uid, bool(other.isForward == section.isForward))
+    return None
+
+
+def _successors(lane: Any) -> tuple[str, ...]:
+    found = [lane._successor.uid] if lane._successor is not None else []
+    found += [m.connectingLane.uid for m in lane.maneuvers if m.connectingLane is not None]
+    return tuple(dict.fromkeys(found))
+
+
+def _lanes(network: Any) -> list[Lane]:
+    connecting = {road.uid for road in network.connectingRoads}
+    successors = {lane.uid: _successors(lane) for lane in network.lanes}
+    predecessors: dict[str, list[str]] = {lane.uid: [] for lane in network.lanes}
+    for lane in network.lanes:
+        if lane._predecessor is not None:
+            predecessors[lane.uid].append(lane._predecessor.uid)
+        for succ in successors[lane.uid]:
+            predecessors.setdefault(succ, []).append(lane.uid)
+    return [
+        Lane(
+            lane.uid,
+            lane.polygon,
+            remove_backtracks(np.asarray(lane.centerline.points, dtype=np.float64)[:, :2]),
+            road=lane.road.uid,
+            is_intersection=lane.road.uid in connecting,
+            successors=successors[lane.uid],
+            predecessors=tuple(dict.fromkeys(predecessors[lane.uid])),
+            left=_neighbour(lane, "Left"),
+            right=_neighbour(lane, "Right"),
+            speed_limit=lane.speedLimit,
+        )
+        for lane in network.lanes
+    ]
+
+
+def _curbs(network: Any) -> tuple[np.ndarray, ...]:
+    groups = [g for road in network.roads for g in (road.forwardLanes, road.backwardLanes) if g]
+    return tuple(np.asarray(g.curb.points, dtype=np.float64)[:, :2] for g in groups)
+
+
+def _areas(elements: Any) -> tuple[Area, ...]:
+    return tuple(Area(e.uid, e.polygons) for e in elements)
+
+
+def convert_network(network: Any, name: str, source: str) -> RoadMap:
+    """A :class:`RoadMap` from a Scenic road network."""
+    intersections = tuple(
+        Area(i.uid, i.polygons, tuple(dict.fromkeys(m.connectingLane.uid for m in i.maneuvers)))
+        for i in network.intersections
+    )
+    roads = tuple(Area(r.uid, r.polygons, tuple(lane.uid for lane in r.lanes)) for r in network.roads)
+    return RoadMap(
+        name,
+        tuple(_lanes(network)),
+        roads,
+        intersections,
+        _areas(network.crossings),
+        _areas(network.sidewalks),
+        _curbs(network),
+        network.drivableRegion.polygons,
+        source,
+    )
+
+
+def _parse(path: Path) -> Any:
+    """Scenic's Network for an .xodr file (imports Scenic: about a second)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        from scenic.domains.driving.roads import Network
+
+        with reading(
+            path,
+            "OpenDRIVE file",
+            ElementTree.ParseError,
+            ValueError,
+            KeyError,
+            AttributeError,
+            IndexError,
+            TypeError,
+            RuntimeError,
+        ):
+            return Network.fromFile(str(path), useCache=False, writeCache=False)
+
+
+def cached_map_path(path: Path) -> Path:
+    """Where the converted map of an .xodr file is cached."""
+    return cache_dir() / "maps" / f"{file_digest(path)[:20]}-scenic{version('scenic')}.map.parquet"
+
+
+def read_map(path: str | Path, key: str | None = None) -> RoadMap:
+    """Read an OpenDRIVE file (``key`` is unused: one map per file), through the cache.
+
+    The cache is best effort: when it cannot be written the map is still returned.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise UserError("no such file", at(path))
+    cached = cached_map_path(path)
+    if cached.is_file():
+        return replace(read_cached(cached), source=str(path))
+    road_map = convert_network(_parse(path), path.stem, str(path))
+    with contextlib.suppress(OSError):
+        write_map_parquet(road_map, cached)
+    return road_map

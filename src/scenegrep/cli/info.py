@@ -1,0 +1,64 @@
+"""``scenegrep info PATH...``: what an input holds (format, frames, duration, objects per class, map)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+
+def add_parser(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "info",
+        help="summarise traces and maps of any supported input",
+        description="Summarise any supported input: format detected, frames, "
+        "duration, objects per class, map elements.",
+    )
+    parser.add_argument("paths", nargs="+", metavar="PATH", help="file or recording directory (- for stdin)")
+    parser.add_argument("--json", action="store_true", help="print one JSON document per path")
+    parser.add_argument("--no-map", action="store_true", help="do not load the traces' maps")
+    parser.set_defaults(run=run)
+
+
+def _classes(counts: dict[str, int]) -> str:
+    return ", ".join(f"{name} {n}" for name, n in counts.items()) or "none"
+
+
+def _trace_lines(t: dict[str, Any]) -> list[str]:
+    duration = "unknown duration" if t["duration_s"] is None else f"{t['duration_s']:.2f} s"
+    rate = f" at {t['rate_hz']:.1f} Hz" if t["rate_hz"] else ""
+    ego = f", ego {t['ego']}" if t["ego"] else ""
+    lines = [f"  trace {t['name']}: {t['frames']} frames, {duration}{rate}, {t['objects']} objects{ego}"]
+    if t["objects"]:
+        lines.append(f"    objects per class: {_classes(t['objects_per_class'])}")
+        lines.append(f"    states: {t['states']} ({t['states_with_lane']} with a lane)")
+    if "behaviour_labels" in t:
+        lines.append(f"    behaviour labels: {_classes(t['behaviour_labels'])}")
+    if "image_samples_per_channel" in t:
+        lines.append(f"    image samples per channel: {_classes(t['image_samples_per_channel'])}")
+        lines.append(f"    image boxes per class: {_classes(t['image_boxes_per_class'])}")
+    return lines
+
+
+def _map_lines(m: dict[str, Any]) -> list[str]:
+    return [
+        f"  map {m['name']}: {m['lanes']} lanes ({m['intersection_lanes']} in intersections), "
+        f"{m['roads']} roads, {m['intersections']} intersections, {m['crosswalks']} crosswalks, "
+        f"{m['sidewalks']} sidewalks, {m['curbs']} curbs; extent {m['extent_m'][0]} x {m['extent_m'][1]} m"
+    ]
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..summary import describe
+
+    for path in args.paths:
+        summary = describe(path, with_map=not args.no_map)
+        if args.json:
+            print(json.dumps(summary))
+            continue
+        print(f"{path}: {summary['description']} [{summary['format']}]")
+        for trace in summary["traces"]:
+            print("\n".join(_trace_lines(trace)))
+        for road_map in summary.get("maps", []):
+            print("\n".join(_map_lines(road_map)))
+    return 0

@@ -1,0 +1,68 @@
+"""``scenegrep``: the entry point. Parses the command, runs it, maps errors to exit codes.
+
+Exit codes: 0 success (for queries: some match), 1 no match, 2 user error
+(printed as one line ``scenegrep: error: PLACE: MESSAGE``), 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from .. import __version__
+from ..errors import UserError
+
+COMMANDS = ("info",)
+"""Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
+
+EXIT_USER_ERROR = 2
+EXIT_INTERRUPTED = 130
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose usage errors are user errors (one line, exit 2)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        raise UserError(f"{self.prog}: {message}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser of every command."""
+    parser = _Parser(
+        prog="scenegrep",
+        description="Find the moments in labeled perception data that match a "
+        "scenario: Scenic scene and scenario queries, Spatial Regular Expressions.",
+    )
+    parser.add_argument("--version", action="version", version=f"scenegrep {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for name in COMMANDS:
+        importlib.import_module(f"{__package__}.{name}").add_parser(subparsers)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one command line; returns the exit code."""
+    try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return EXIT_USER_ERROR
+        return int(args.run(args))
+    except UserError as exc:
+        print(f"scenegrep: error: {exc.one_line()}", file=sys.stderr)
+        if exc.detail:
+            print(exc.detail, file=sys.stderr)
+        return EXIT_USER_ERROR
+    except KeyboardInterrupt:
+        print("scenegrep: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        sys.stderr.close()
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

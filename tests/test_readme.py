@@ -1,0 +1,29 @@
+"""The README stays true: its test command is what CI runs; its quick-start main job works."""
+
+import re
+from pathlib import Path
+
+from scenegrep.cli.main import main
+
+REPO = Path(__file__).resolve().parents[1]
+README = (REPO / "README.md").read_text()
+
+
+def quick_start() -> list[str]:
+    section = README.split("## Quick start", 1)[1].split("\n## ", 1)[0]
+    return re.findall(r"```\n(.+?)\n```", section)
+
+
+def test_two_quick_start_commands():
+    assert len(quick_start()) == 2
+
+
+def test_ci_runs_the_readme_test_command():
+    ci = (REPO / ".ci" / "run").read_text()
+    assert quick_start()[1] in ci.splitlines()
+
+
+def test_quick_start_main_job_runs(monkeypatch):
+    monkeypatch.chdir(REPO)
+    command = quick_start()[0].split(".venv/bin/scenegrep ", 1)[1]
+    assert main(command.split()) == 0

@@ -8,10 +8,12 @@ from __future__ import annotations
 import json
 import re
 from collections.abc import Sequence
-
-import msgspec
+from typing import TYPE_CHECKING
 
 from ..errors import UserError, at
+
+if TYPE_CHECKING:
+    import msgspec
 
 _DECODER = json.JSONDecoder()
 _WS = re.compile(r"[ \t\r\n]*")
@@ -80,6 +82,8 @@ def byte_offset(document: bytes, path: Sequence[str | int]) -> int:
 def msgspec_error(exc: msgspec.MsgspecError, data: bytes, start: int, source: str) -> UserError:
     """A one-line user error at the place that a msgspec decode error of the JSON document
     starting at byte ``start`` of ``data`` names (a JSON path, or a byte offset)."""
+    import msgspec
+
     text = str(exc)
     if isinstance(exc, msgspec.ValidationError):
         message, _, path = text.partition(" - at `")

@@ -1,0 +1,25 @@
+"""Errors in a query: one line with the place (``<query>:line:column``) and a caret display."""
+
+from __future__ import annotations
+
+from ..errors import UserError, at
+
+
+def line_column(text: str, offset: int) -> tuple[int, int]:
+    """1-based line and column of an offset in the query text."""
+    line_start = text.rfind("\n", 0, offset) + 1
+    return text.count("\n", 0, offset) + 1, offset - line_start + 1
+
+
+def caret(text: str, start: int, end: int) -> str:
+    """The query line holding ``start`` with carets under [start, end)."""
+    line_start = text.rfind("\n", 0, start) + 1
+    line_end = text.find("\n", start)
+    line = text[line_start : len(text) if line_end < 0 else line_end]
+    width = max(1, min(end, line_start + len(line)) - start)
+    return f"  {line}\n  {' ' * (start - line_start)}{'^' * width}"
+
+
+def query_error(message: str, text: str, start: int, end: int, source: str = "<query>") -> UserError:
+    """A :class:`UserError` at [start, end) of the query text, with a caret display as detail."""
+    return UserError(message, at(source, *line_column(text, start)), detail=caret(text, start, end))

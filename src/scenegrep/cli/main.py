@@ -6,15 +6,19 @@ Exit codes: 0 success (for queries: some match), 1 no match, 2 user error
 
 from __future__ import annotations
 
-import argparse
-import importlib
-import sys
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # scenegrep uses no BLAS threads; idle ones spin on a core
+
+import argparse  # noqa: E402
+import importlib  # noqa: E402
+import sys  # noqa: E402
 from collections.abc import Sequence
 
-from .. import __version__
-from ..errors import UserError
+from .. import __version__  # noqa: E402
+from ..errors import UserError  # noqa: E402
 
-COMMANDS = ("info",)
+COMMANDS = ("info", "spre")
 """Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
 
 EXIT_USER_ERROR = 2

@@ -1,11 +1,18 @@
-"""The data model every query reads: label traces and road maps. Imports no query code."""
+"""The data model every query reads: label traces and road maps. Imports no query code.
+
+The road-map classes load on first use (they need shapely), so code that only reads
+traces, such as a SpRE run over a STREM stream, does not pay for them.
+"""
+
+from typing import Any
 
 from .behaviours import BehaviourLabels
 from .images import BoxTable, ImageLayer, SampleTable
 from .objects import ObjectTable
-from .roadmap import Area, Lane, LaneNeighbour, RoadMap
 from .states import StateTable
 from .trace import LabelTrace, MapSource, TraceSource
+
+_ROADMAP = ("Area", "Lane", "LaneNeighbour", "RoadMap")
 
 __all__ = [
     "Area",
@@ -22,3 +29,11 @@ __all__ = [
     "StateTable",
     "TraceSource",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _ROADMAP:
+        from . import roadmap
+
+        return getattr(roadmap, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

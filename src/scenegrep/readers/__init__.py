@@ -21,8 +21,13 @@ from pathlib import Path
 from types import ModuleType
 from collections.abc import Iterator
 
+from typing import TYPE_CHECKING
+
 from ..errors import UserError, at
-from ..model import LabelTrace, MapSource, RoadMap
+from ..model import LabelTrace, MapSource
+
+if TYPE_CHECKING:
+    from ..model import RoadMap
 
 
 @dataclass(frozen=True)
@@ -34,6 +39,8 @@ class Format:
     description: str
     traces: bool
     map: bool
+    many: bool = False
+    """Whether one file may hold several traces (outputs then name the trace as well as the file)."""
 
 
 FORMATS: dict[str, Format] = {
@@ -57,7 +64,7 @@ FORMATS: dict[str, Format] = {
         Format(
             "scenarionet", "scenarionet", "ScenarioNet pickle (nuScenes, Waymo, ...), restricted unpickling", True, True
         ),
-        Format("waymo-tfrecord", "waymo_tfrecord", "Waymo Open Motion Scenario TFRecord", True, True),
+        Format("waymo-tfrecord", "waymo_tfrecord", "Waymo Open Motion Scenario TFRecord", True, True, many=True),
         Format("commonroad", "commonroad", "CommonRoad 2018b/2020a scenario XML", True, True),
         Format("opendrive", "opendrive", "OpenDRIVE road network (.xodr) through Scenic", False, True),
     )

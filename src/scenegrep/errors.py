@@ -54,3 +54,9 @@ def at(
 ) -> SourceLocation:
     """Shorthand for a :class:`SourceLocation`."""
     return SourceLocation(str(source), line, column, path)
+
+
+def caret(line: str, column: int, width: int = 1) -> str:
+    """A two-line display: the source ``line`` and carets under 1-based columns [column, column + width)."""
+    width = max(1, min(width, len(line) - column + 1))
+    return f"  {line}\n  {' ' * (column - 1)}{'^' * width}"

@@ -40,19 +40,3 @@ def line_strings(lines: list[np.ndarray]) -> np.ndarray:
     coords = np.concatenate([np.asarray(line, dtype=np.float64)[:, :2] for line in lines])
     indices = np.repeat(np.arange(len(lines)), [len(line) for line in lines])
     return shapely.linestrings(coords, indices=indices)
-
-
-def remove_backtracks(line: np.ndarray) -> np.ndarray:
-    """The polyline without the vertices where it doubles back (a segment pointing against the
-    one before it), as stitched map geometry sometimes does for a few centimetres; repeated
-    until no segment reverses. The end points are kept."""
-    points = np.asarray(line, dtype=np.float64)
-    while len(points) > 2:
-        step = np.diff(points, axis=0)
-        reverse = np.flatnonzero(np.einsum("ij,ij->i", step[1:], step[:-1]) <= 0) + 1
-        if len(reverse) == 0:
-            break
-        keep = np.ones(len(points), dtype=bool)
-        keep[reverse[0]] = False
-        points = points[keep]
-    return points

@@ -18,11 +18,9 @@ import shapely
 from shapely import STRtree
 from shapely.geometry.base import BaseGeometry
 
-from .geometry import heading_difference, heading_of_vector
+from .geometry import heading_difference
 from .lane_shapes import line_strings
-
-_TANGENT_STEP_M = 0.5
-"""Half the chord (m) used to measure a centreline's direction at a point."""
+from .polylines import Polylines
 
 
 @dataclass(frozen=True)
@@ -95,6 +93,16 @@ class RoadMap:
         return line_strings([lane.centreline for lane in self.lanes])
 
     @cached_property
+    def centreline_polylines(self) -> Polylines:
+        """The lane centrelines as :class:`Polylines` (direction queries)."""
+        return Polylines([lane.centreline for lane in self.lanes])
+
+    @cached_property
+    def curb_polylines(self) -> Polylines:
+        """The curbs as :class:`Polylines`."""
+        return Polylines(list(self.curbs))
+
+    @cached_property
     def lane_is_intersection(self) -> np.ndarray:
         return np.array([lane.is_intersection for lane in self.lanes], dtype=bool)
 
@@ -164,8 +172,9 @@ class RoadMap:
         return result
 
     def lane_direction_at(self, x: np.ndarray, y: np.ndarray, lane: np.ndarray | None = None) -> np.ndarray:
-        """Direction of travel (heading, radians) at each point: the tangent of the centreline
-        of ``lane`` (or of the lane found by :meth:`lane_at`) at the point's projection; NaN off-lane."""
+        """Direction of travel (heading, radians) at each point: the direction of the centreline
+        of ``lane`` (or of the lane found by :meth:`lane_at`) at the point (see :meth:`_directions`);
+        NaN off-lane."""
         x, y = np.atleast_1d(np.asarray(x, dtype=float)), np.atleast_1d(np.asarray(y, dtype=float))
         lane = self.lane_at(x, y) if lane is None else np.atleast_1d(lane)
         out = np.full(len(x), np.nan)
@@ -200,12 +209,9 @@ class RoadMap:
         return inside
 
     def _directions(self, lane_idx: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        lines = self.lane_centrelines[lane_idx]
-        s = shapely.line_locate_point(lines, shapely.points(x, y))
-        length = shapely.length(lines)
-        a = shapely.line_interpolate_point(lines, np.clip(s - _TANGENT_STEP_M, 0, length))
-        b = shapely.line_interpolate_point(lines, np.clip(s + _TANGENT_STEP_M, 0, length))
-        return heading_of_vector(shapely.get_x(b) - shapely.get_x(a), shapely.get_y(b) - shapely.get_y(a))
+        """Direction of travel of lane ``lane_idx[i]`` at point i: the heading of its centreline's
+        segment nearest to the point by projection (Scenic's rule)."""
+        return self.centreline_polylines.direction_at(lane_idx, x, y)
 
     # ------------------------------------------------------------------ comparison
     def equals(self, other: object) -> bool:

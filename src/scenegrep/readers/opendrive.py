@@ -7,10 +7,11 @@ for a CARLA town); the result is converted to the data model's
 milliseconds and never import Scenic. Scenic's own ``.snet`` cache is not used:
 it would be written beside the map, which may be read-only.
 
-Scenic's centrelines sometimes double back for a few centimetres where OpenDRIVE
-geometry pieces overlap (168 vertices in Town01); those vertices are dropped
-(:func:`scenegrep.model.lane_shapes.remove_backtracks`), so directions along a lane are
-those of travel everywhere.
+Centrelines are Scenic's, vertex for vertex, so lane directions (the heading of the
+centreline segment a point projects onto) are exactly Scenic's ``roadDirection``; where
+OpenDRIVE geometry pieces overlap they double back for a few centimetres (168 vertices
+in Town01), and points projecting onto those short segments get the reversed
+direction there, as in Scenic.
 
 Conversion (through the private accessors ``_successor``, ``_predecessor``, ``_laneToLeft``,
 ``_laneToRight``, which return None where the public ones reject): every Scenic lane is
@@ -39,12 +40,13 @@ import numpy as np
 from ..cache import cache_dir, file_digest
 from ..errors import UserError, at
 from ..model import Area, Lane, LaneNeighbour, RoadMap
-from ..model.lane_shapes import remove_backtracks
 from ..writers.trace_parquet import write_map_parquet
 from .common import reading
 from .trace_parquet import read_map as read_cached
 
 FORMAT = "opendrive"
+CONVERSION_VERSION = 2
+"""Bumped whenever the conversion changes, so cached maps are rebuilt."""
 
 
 def _neighbour(lane: Any, side: str) -> LaneNeighbour | None:
@@ -74,7 +76,7 @@ def _lanes(network: Any) -> list[Lane]:
         Lane(
             lane.uid,
             lane.polygon,
-            remove_backtracks(np.asarray(lane.centerline.points, dtype=np.float64)[:, :2]),
+            np.asarray(lane.centerline.points, dtype=np.float64)[:, :2],
             road=lane.road.uid,
             is_intersection=lane.road.uid in connecting,
             successors=successors[lane.uid],
@@ -138,7 +140,9 @@ def _parse(path: Path) -> Any:
 
 def cached_map_path(path: Path) -> Path:
     """Where the converted map of an .xodr file is cached."""
-    return cache_dir() / "maps" / f"{file_digest(path)[:20]}-scenic{version('scenic')}.map.parquet"
+    return (
+        cache_dir() / "maps" / f"{file_digest(path)[:20]}-scenic{version('scenic')}-v{CONVERSION_VERSION}.map.parquet"
+    )
 
 
 def read_map(path: str | Path, key: str | None = None) -> RoadMap:

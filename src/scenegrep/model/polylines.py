@@ -1,0 +1,78 @@
+"""Sets of polylines (lane centrelines, curbs) with vectorised direction queries.
+
+The direction of a polyline at a point follows Scenic (``PolylineRegion.nearestSegmentTo``):
+project the point onto the polyline, take the segment holding that arc length, and
+return the segment's heading. Zero-length segments are dropped first.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import numpy as np
+import shapely
+
+from .geometry import heading_of_vector
+from .lane_shapes import line_strings
+
+
+class Polylines:
+    """Polylines (k_i x 2 arrays, metres) flattened into segments; see the module docstring."""
+
+    def __init__(self, lines: list[np.ndarray] | tuple[np.ndarray, ...]):
+        cleaned = [_without_repeats(np.asarray(line, dtype=np.float64)[:, :2]) for line in lines]
+        self.lines = cleaned
+        counts = np.array([max(len(line) - 1, 0) for line in cleaned], dtype=np.intp)
+        self.first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.intp) if len(counts) else counts
+        self.count = counts
+        starts = [line[:-1] for line in cleaned if len(line) > 1]
+        ends = [line[1:] for line in cleaned if len(line) > 1]
+        self.start = np.concatenate(starts) if starts else np.zeros((0, 2))
+        self.end = np.concatenate(ends) if ends else np.zeros((0, 2))
+        delta = self.end - self.start
+        self.heading = heading_of_vector(delta[:, 0], delta[:, 1])
+        owner = np.repeat(np.arange(len(cleaned)), counts)
+        lengths = np.hypot(delta[:, 0], delta[:, 1])
+        line_lengths = np.bincount(owner, weights=lengths, minlength=len(cleaned)) if len(owner) else np.zeros(0)
+        self.base = np.concatenate([[0.0], np.cumsum(line_lengths)[:-1]]) if len(cleaned) else np.zeros(0)
+        self.arc_end = np.cumsum(lengths)
+        self.local_end = np.concatenate(
+            [np.cumsum(lengths[f : f + c]) for f, c in zip(self.first.tolist(), counts.tolist())] or [np.zeros(0)]
+        )
+
+    @cached_property
+    def geometries(self) -> np.ndarray:
+        """One shapely LineString per polyline."""
+        return line_strings(self.lines)
+
+    def __len__(self) -> int:
+        return len(self.lines)
+
+    def segment_at(self, line: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Index (into the flat segment arrays) of the segment of polyline ``line[i]`` nearest
+        to point i, by projection (Scenic's rule)."""
+        line = np.asarray(line, dtype=np.intp)
+        arc = shapely.line_locate_point(self.geometries[line], shapely.points(x, y))
+        low, high = self.first[line], self.first[line] + np.maximum(self.count[line] - 1, 0)
+        found = np.clip(np.searchsorted(self.arc_end, arc + self.base[line], side="left"), low, high)
+        # the global search can be off by one at ties; settle them on the per-line arc lengths,
+        # summed as Scenic sums them: the first segment whose end is at or beyond the arc
+        previous = np.maximum(found - 1, low)
+        found = np.where((found > low) & (arc <= self.local_end[previous]), previous, found)
+        following = np.minimum(found + 1, high)
+        return np.where((found < high) & (arc > self.local_end[found]), following, found)
+
+    def direction_at(self, line: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Heading (radians) of polyline ``line[i]`` at point i (its nearest segment's heading)."""
+        if len(np.atleast_1d(line)) == 0:
+            return np.zeros(0)
+        return self.heading[self.segment_at(line, x, y)]
+
+
+def _without_repeats(points: np.ndarray) -> np.ndarray:
+    """The polyline without consecutive duplicate vertices."""
+    if len(points) < 2:
+        return points
+    keep = np.ones(len(points), dtype=bool)
+    keep[1:] = np.any(np.diff(points, axis=0) != 0, axis=1)
+    return points[keep]

@@ -1,0 +1,220 @@
+"""Deciding one group for all rows: is there a value of its random variables that reproduces
+the labeled features (within tolerance) and satisfies its requirements?
+
+The fast paths are vectorised closed forms over all rows at once:
+
+* no unknowns: evaluate and compare;
+* one scalar unknown ``u`` on which every constraint is affine: each constraint
+  ``lo <= a*u + c <= hi`` is an interval of ``u``; intersect them with ``u``'s
+  range, then check the (at most one) heading constraint modulo 2π on the
+  interval of values it takes there;
+* one random point pinned by the position features (``position = p + known``):
+  the tolerance box of ``p`` must meet the point's region (R-tree
+  point-in-polygon, exact).
+
+Anything else is decided row by row by :mod:`.solvers` (linear programming,
+SMT, interval branch-and-prune).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .dependencies import Group
+from .evaluate import Affine, Evaluator, NotAffine
+from .program import Feature
+from .terms import Term
+
+TWO_PI = 2 * np.pi
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    """Per-feature tolerances: positions and sizes in metres, headings in radians."""
+
+    position: float = 1e-6
+    heading: float = 1e-6
+
+    def of(self, feature: Feature) -> float:
+        return self.heading if feature.is_angle else self.position
+
+
+@dataclass
+class Linear:
+    """``lo <= form <= hi`` over rows; ``angle`` constraints hold modulo 2π."""
+
+    form: Affine
+    lo: np.ndarray
+    hi: np.ndarray
+    angle: bool = False
+
+
+def decide(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
+    """Which of the evaluator's original rows have a feasible assignment (bool array)."""
+    for leaf in sorted((u for u in group.unknowns if u.op == "choice"), key=repr):
+        ev.expand_choice(leaf)
+    ev.unknowns = frozenset(u for u in group.unknowns if u.op != "choice")
+    ok = _decide_expanded(ev, group, tolerance)
+    found = np.zeros(len(ev.rows), dtype=bool)
+    found[ev.origin[ok]] = True
+    return found
+
+
+def _decide_expanded(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
+    if not ev.unknowns:
+        return _direct(ev, group, tolerance)
+    try:
+        linear = _linear_constraints(ev, group, tolerance)
+    except NotAffine:
+        linear = None
+    if linear is not None:
+        scalars = {u for c in linear for u in c.form.coefs}
+        points = {u.value[0] for u in ev.unknowns if u.op == "point"}
+        turning = sum(1 for c in linear if c.angle and c.form.coefs)
+        if not points and len(scalars) <= 1 and turning <= 1:
+            return _one_unknown(ev, linear)
+        pinned = _pinned_point(ev, linear, points)
+        if pinned is not None:
+            return pinned
+    from .solvers import decide_rows
+
+    return decide_rows(ev, group, tolerance)
+
+
+def _direct(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
+    for feature in group.features:
+        ev.value(feature.term)
+        ev.value(feature.observed)
+    for requirement in group.requirements:
+        ev.value(requirement.condition)
+    ok = np.ones(ev.size, dtype=bool)
+    for feature in group.features:
+        diff = ev.memo[feature.term] - ev.memo[feature.observed]
+        if feature.is_angle:
+            diff = np.pi - np.mod(np.pi - diff, TWO_PI)
+        ok &= np.abs(diff) <= tolerance.of(feature)
+    for requirement in group.requirements:
+        ok &= ev.memo[requirement.condition].astype(bool)
+    return ok
+
+
+# ---------------------------------------------------------------------------- linear systems
+def _linear_constraints(ev: Evaluator, group: Group, tolerance: Tolerance) -> list[Linear]:
+    """The group's constraints as affine ones, with the ranges of its random variables; raises
+    :class:`NotAffine` when some constraint is not (a conjunction of) affine comparisons.
+
+    Built twice: the first pass computes (and may expand rows), the second reads the memoised,
+    re-indexed results, so every array has the final number of rows.
+    """
+    _build_linear(ev, group, tolerance)
+    return _build_linear(ev, group, tolerance)
+
+
+def _build_linear(ev: Evaluator, group: Group, tolerance: Tolerance) -> list[Linear]:
+    constraints: list[Linear] = []
+    for feature in group.features:
+        form = ev.affine(feature.term)
+        observed = ev.value(feature.observed)
+        tol = tolerance.of(feature)
+        constraints.append(Linear(form, observed - tol, observed + tol, feature.is_angle))
+    for requirement in group.requirements:
+        constraints.extend(_comparisons(ev, requirement.condition))
+    for u in ev.unknowns:
+        if u.op == "var":
+            low, high = ev.value(u.value.low), ev.value(u.value.high)
+            constraints.append(Linear(ev.affine(u), low, high))
+    return constraints
+
+
+def _comparisons(ev: Evaluator, condition: Term) -> list[Linear]:
+    """A requirement that is a conjunction of comparisons of affine terms, as constraints.
+
+    Strict and non-strict comparisons are the same here (they differ on a set of measure zero).
+    """
+    if condition.op == "and":
+        return [c for part in condition.args for c in _comparisons(ev, part)]
+    negated = condition.op == "not" and condition.args[0].op in ("lt", "le")
+    comparison = condition.args[0] if negated else condition
+    if comparison.op not in ("lt", "le"):
+        if ev.depends_on_unknowns(condition):
+            raise NotAffine(f"{condition.op} of unknowns")
+        ok = ev.value(condition).astype(float)
+        return [Linear(Affine(ok, {}), np.ones(ev.size), np.ones(ev.size))]
+    left, right = (ev.affine(a) for a in comparison.args)
+    difference = right.plus(left, -1.0) if negated else left.plus(right, -1.0)
+    return [Linear(difference, np.full(ev.size, -np.inf), np.zeros(ev.size))]
+
+
+def _one_unknown(ev: Evaluator, constraints: list[Linear]) -> np.ndarray:
+    """Feasibility when at most one scalar unknown appears (vectorised interval intersection)."""
+    n = ev.size
+    low, high = np.full(n, -np.inf), np.full(n, np.inf)
+    ok = np.ones(n, dtype=bool)
+    angles = []
+    for c in constraints:
+        coef = next(iter(c.form.coefs.values()), np.zeros(n))
+        if c.angle and np.any(coef != 0):
+            angles.append((c, coef))
+            continue
+        if c.angle:
+            ok &= _angle_gap(c.form.const, c.form.const, (c.lo + c.hi) / 2) <= (c.hi - c.lo) / 2
+            continue
+        fixed = coef == 0
+        ok &= ~fixed | ((c.lo <= c.form.const) & (c.form.const <= c.hi))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = (c.lo - c.form.const) / coef
+            b = (c.hi - c.form.const) / coef
+        low = np.where(fixed, low, np.maximum(low, np.minimum(a, b)))
+        high = np.where(fixed, high, np.minimum(high, np.maximum(a, b)))
+    ok &= low <= high
+    for c, coef in angles:
+        ends = (coef * low + c.form.const, coef * high + c.form.const)
+        lo_v, hi_v = np.minimum(*ends), np.maximum(*ends)
+        ok &= _angle_gap(lo_v, hi_v, (c.lo + c.hi) / 2) <= (c.hi - c.lo) / 2
+    return ok
+
+
+def _angle_gap(lo: np.ndarray, hi: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """The smallest |wrap(v - target)| over v in [lo, hi] (0 when the interval reaches the target mod 2π)."""
+    width = hi - lo
+    ahead = np.mod(target - lo, TWO_PI)  # from lo forward to the next copy of the target
+    inside = (ahead <= width) | (width >= TWO_PI)
+    return np.where(inside, 0.0, np.minimum(ahead - width, TWO_PI - ahead))
+
+
+def _pinned_point(ev: Evaluator, constraints: list[Linear], points: set) -> np.ndarray | None:
+    """Feasibility when the only unknown is a random point the position features pin down."""
+    if len(points) != 1 or len(ev.unknowns) != 2:
+        return None
+    point = next(iter(points))
+    px, py = sorted(ev.unknowns, key=lambda u: u.value[1])
+    box: dict[Term, tuple[np.ndarray, np.ndarray]] = {}
+    rest = []
+    for c in constraints:
+        if not c.form.coefs:
+            rest.append(c)
+            continue
+        if c.angle or len(c.form.coefs) != 1:
+            return None
+        ((u, coef),) = c.form.coefs.items()
+        if not np.all(coef == 1):
+            return None
+        lo, hi = c.lo - c.form.const, c.hi - c.form.const
+        if u in box:
+            lo, hi = np.maximum(lo, box[u][0]), np.minimum(hi, box[u][1])
+        box[u] = (lo, hi)
+    if set(box) != {px, py}:
+        return None
+    region = point.region
+    for term in region.terms():
+        if ev.depends_on_unknowns(term):
+            return None
+        ev.value(term)
+    (x_lo, x_hi), (y_lo, y_hi) = box[px], box[py]
+    ok = (x_lo <= x_hi) & (y_lo <= y_hi)
+    for c in rest:
+        ok &= (c.lo <= c.form.const) & (c.form.const <= c.hi)
+    ok &= ev.geometry.boxes_meet(region, x_lo, x_hi, y_lo, y_hi, ev.value)
+    return ok

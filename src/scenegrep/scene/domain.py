@@ -1,0 +1,129 @@
+"""The Scenic classes a scene program may instantiate, with Scenic 3.1.1's property defaults.
+
+Defaults are written in Scenic itself (2-D compatibility mode, driving domain:
+``scenic/domains/driving/model.scenic`` and ``scenic/core/object_types.py``) and
+evaluated by the resolver like program text, with ``self`` the object being
+built. ``kinds`` are the label kinds (:data:`scenegrep.model.taxonomy.KINDS`)
+an instance may correspond to; ``None`` means any. Truck, Bus, Motorcycle and
+Bicycle are not in Scenic's abstract driving domain (its simulator models add
+them); they are vehicles here, so programs can name what datasets label.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cache
+
+from ..scenic import ir
+from ..scenic.adapter import parse_program
+
+VEHICLE_KINDS = frozenset({"car", "truck", "bus", "trailer", "motorcycle", "bicycle"})
+
+
+@dataclass(frozen=True)
+class ClassSpec:
+    """A Scenic class: its parent, whether its instances are scene objects, label kinds and defaults."""
+
+    name: str
+    parent: str | None
+    defaults: dict[str, str] = field(default_factory=dict)
+    is_object: bool = False
+    kinds: frozenset[str] | None = None
+
+
+CLASSES: dict[str, ClassSpec] = {
+    spec.name: spec
+    for spec in (
+        ClassSpec("Point", None, {"position": "(0, 0)", "visibleDistance": "50", "width": "0", "length": "0"}),
+        ClassSpec("OrientedPoint", "Point", {"yaw": "0", "parentOrientation": "0", "viewAngle": "360 deg"}),
+        ClassSpec(
+            "Object",
+            "OrientedPoint",
+            {
+                "width": "1",
+                "length": "1",
+                "regionContainedIn": "None",
+                "requireVisible": "True",
+                "allowCollisions": "False",
+                "contactTolerance": "0",
+            },
+            is_object=True,
+        ),
+        ClassSpec("DrivingObject", "Object", {"requireVisible": "False"}, is_object=True),
+        ClassSpec(
+            "Vehicle",
+            "DrivingObject",
+            {
+                "regionContainedIn": "roadOrShoulder",
+                "position": "new Point on road",
+                "parentOrientation": "(roadDirection at self.position) + self.roadDeviation",
+                "roadDeviation": "0",
+                "viewAngle": "90 deg",
+                "width": "2",
+                "length": "4.5",
+            },
+            is_object=True,
+            kinds=VEHICLE_KINDS,
+        ),
+        ClassSpec("Car", "Vehicle", is_object=True, kinds=frozenset({"car"})),
+        ClassSpec("NPCCar", "Car", is_object=True, kinds=frozenset({"car"})),
+        ClassSpec("Truck", "Vehicle", {"width": "2.5", "length": "8"}, is_object=True, kinds=frozenset({"truck"})),
+        ClassSpec("Bus", "Vehicle", {"width": "2.5", "length": "12"}, is_object=True, kinds=frozenset({"bus"})),
+        ClassSpec(
+            "Motorcycle", "Vehicle", {"width": "1", "length": "2"}, is_object=True, kinds=frozenset({"motorcycle"})
+        ),
+        ClassSpec("Bicycle", "Vehicle", {"width": "1", "length": "2"}, is_object=True, kinds=frozenset({"bicycle"})),
+        ClassSpec(
+            "Pedestrian",
+            "DrivingObject",
+            {
+                "regionContainedIn": "network.walkableRegion",
+                "position": "new Point on network.walkableRegion",
+                "parentOrientation": "Range(0, 360) deg",
+                "viewAngle": "90 deg",
+                "width": "0.75",
+                "length": "0.75",
+            },
+            is_object=True,
+            kinds=frozenset({"pedestrian"}),
+        ),
+    )
+}
+
+MODELS = (
+    "scenic.domains.driving.model",
+    "scenic.simulators.newtonian.driving_model",
+    "scenic.simulators.carla.model",
+    "scenic.simulators.metadrive.model",
+)
+"""World models a program may name: all give the driving domain's classes and map names."""
+
+
+def lineage(name: str) -> list[ClassSpec]:
+    """The class and its ancestors, most derived first."""
+    chain = []
+    spec: ClassSpec | None = CLASSES[name]
+    while spec is not None:
+        chain.append(spec)
+        spec = CLASSES[spec.parent] if spec.parent else None
+    return chain
+
+
+@cache
+def default_expression(class_name: str, prop: str) -> ir.Node | None:
+    """The IR of the default of ``prop`` for ``class_name`` (inherited), or None."""
+    for spec in lineage(class_name):
+        if prop in spec.defaults:
+            program = parse_program(f"value = {spec.defaults[prop]}\n", f"<default {spec.name}.{prop}>")
+            statement = program.statements[0]
+            assert isinstance(statement, ir.Assign)
+            return statement.value
+    return None
+
+
+def defaulted_properties(class_name: str) -> list[str]:
+    """Every property with a default for the class, base classes' first."""
+    names: list[str] = []
+    for spec in reversed(lineage(class_name)):
+        names.extend(p for p in spec.defaults if p not in names)
+    return names

@@ -1,0 +1,294 @@
+"""Vectorised evaluation of terms over rows of partial correspondences.
+
+A row is one candidate: a frame and, for each program object matched so far,
+the label state it corresponds to. :class:`Evaluator` computes terms for all
+rows at once with numpy: :meth:`~Evaluator.value` for terms that depend only
+on label values, :meth:`~Evaluator.affine` for terms linear in the group's
+unknown random variables (``const + Σ coef·u``). Where a term has several
+possible values for one row — a finite ``Options`` choice, or the road
+direction inside an intersection — the evaluator *expands*: the row is copied
+once per value, and ``origin`` maps the copies back to the original rows, so
+the caller can accept a row when any copy is feasible.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model.geometry import heading_of_vector, normalize_angle
+from .geometry import MapGeometry
+from .program import ProgramObject
+from .regions import Region
+from .terms import Term
+
+
+class NotAffine(Exception):
+    """A term is not linear in the unknowns (the caller falls back to a general solver)."""
+
+
+@dataclass
+class Labels:
+    """Label state columns of one trace (indexed by state row) and its trace attributes."""
+
+    x: np.ndarray
+    y: np.ndarray
+    heading: np.ndarray
+    length: np.ndarray
+    width: np.ndarray
+    attributes: dict = field(default_factory=dict)
+
+
+@dataclass
+class Rows:
+    """Partial correspondences: ``frame[i]`` and ``state[obj][i]``, the label state row matched to
+    program object ``obj`` in row i."""
+
+    frame: np.ndarray
+    state: dict[str, np.ndarray]
+
+    def __len__(self) -> int:
+        return len(self.frame)
+
+    def take(self, idx: np.ndarray) -> Rows:
+        return Rows(self.frame[idx], {k: v[idx] for k, v in self.state.items()})
+
+
+@dataclass
+class Affine:
+    """``const + Σ coefs[u] * u`` over rows; ``coefs`` maps unknown leaves to coefficient arrays."""
+
+    const: np.ndarray
+    coefs: dict[Term, np.ndarray]
+
+    def take(self, idx: np.ndarray) -> Affine:
+        return Affine(self.const[idx], {u: c[idx] for u, c in self.coefs.items()})
+
+    def scaled(self, k: np.ndarray) -> Affine:
+        return Affine(self.const * k, {u: c * k for u, c in self.coefs.items()})
+
+    def plus(self, other: Affine, sign: float = 1.0) -> Affine:
+        coefs = dict(self.coefs)
+        for u, c in other.coefs.items():
+            coefs[u] = coefs[u] + sign * c if u in coefs else sign * c
+        return Affine(self.const + sign * other.const, coefs)
+
+
+_UNARY = {
+    "neg": np.negative,
+    "abs": np.abs,
+    "sin": np.sin,
+    "cos": np.cos,
+    "wrap": normalize_angle,
+}
+_BINARY = {
+    "add": np.add,
+    "sub": np.subtract,
+    "mul": np.multiply,
+    "min": np.minimum,
+    "max": np.maximum,
+    "lt": np.less,
+    "le": np.less_equal,
+    "eq": np.equal,
+    "ne": np.not_equal,
+    "and": np.logical_and,
+    "or": np.logical_or,
+}
+
+
+class Evaluator:
+    """Evaluates terms over rows, expanding rows for multi-valued terms; see the module docstring."""
+
+    def __init__(
+        self,
+        rows: Rows,
+        labels: Labels,
+        objects: dict[str, ProgramObject],
+        geometry: MapGeometry,
+        unknowns: frozenset[Term] = frozenset(),
+        position_tolerance: float = 0.0,
+    ):
+        self.rows = rows
+        self.labels = labels
+        self.objects = objects
+        self.geometry = geometry
+        self.unknowns = unknowns
+        self.position_tolerance = position_tolerance
+        self.origin = np.arange(len(rows))
+        self.memo: dict[Term, np.ndarray] = {}
+        self.affine_memo: dict[Term, Affine] = {}
+
+    @property
+    def size(self) -> int:
+        return len(self.origin)
+
+    # ---------------------------------------------------------------- expansion
+    def expand(self, idx: np.ndarray) -> None:
+        """Keep (and copy) current rows ``idx``: every computed array follows."""
+        self.origin = self.origin[idx]
+        self.memo = {t: a[idx] for t, a in self.memo.items()}
+        self.affine_memo = {t: a.take(idx) for t, a in self.affine_memo.items()}
+
+    def expand_choice(self, choice: Term) -> None:
+        """Copy every row once per alternative of a finite choice, binding the choice's value."""
+        size = choice.value.size
+        n = self.size
+        self.expand(np.repeat(np.arange(n), size))
+        self.memo[choice] = np.tile(np.arange(size, dtype=float), n)
+
+    def depends_on_unknowns(self, term: Term) -> bool:
+        return bool(self.unknowns) and (term in self.unknowns or not self.unknowns.isdisjoint(term.leaves()))
+
+    # ---------------------------------------------------------------- known values
+    def value(self, term: Term) -> np.ndarray:
+        """The term's value in every current row (it must not depend on the unknowns)."""
+        found = self.memo.get(term)
+        if found is not None:
+            return found
+        if term in self.unknowns:
+            raise NotAffine(f"{term!r} is unknown")
+        result = self._compute(term)
+        if term not in self.memo:  # an expansion may already have stored it
+            self.memo[term] = result
+        return self.memo[term]
+
+    def _args(self, term: Term) -> list[np.ndarray]:
+        for arg in term.args:
+            self.value(arg)
+        for part in _value_terms(term.value):
+            self.value(part)
+        return [self.memo[arg] for arg in term.args]
+
+    def _compute(self, term: Term) -> np.ndarray:
+        op = term.op
+        n = self.size
+        if op == "const":
+            return np.full(n, term.value, dtype=object if term.kind in ("str", "none") else None)
+        if op == "observed":
+            return self._observed(*term.value)
+        if op in _UNARY:
+            return _UNARY[op](self._args(term)[0])
+        if op in _BINARY:
+            a, b = self._args(term)
+            return _BINARY[op](a, b)
+        if op == "div":
+            a, b = self._args(term)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                return a / b
+        if op == "pow":
+            return self._args(term)[0] ** term.value
+        if op == "sqrt":
+            with np.errstate(invalid="ignore"):
+                return np.sqrt(self._args(term)[0])
+        if op == "heading_of":
+            dx, dy = self._args(term)
+            return heading_of_vector(dx, dy)
+        if op == "not":
+            return ~self._args(term)[0]
+        if op == "ite":
+            test, body, orelse = self._args(term)
+            return np.where(test, body, orelse)
+        if op == "select":
+            args = self._args(term)
+            return np.choose(args[0].astype(np.intp), args[1:])
+        return self._geometry(term)
+
+    def _observed(self, obj: str, feature: str) -> np.ndarray:
+        states = self.rows.state[obj][self.origin]
+        column = getattr(self.labels, feature)[states]
+        if feature in ("width", "length"):
+            column = np.where(np.isnan(column), self.objects[obj].default_size[feature], column)
+        return column
+
+    def _geometry(self, term: Term) -> np.ndarray:
+        op = term.op
+        if op == "field":
+            return self._field(term)
+        args = self._args(term)
+        value = self.value
+        region: Region = term.value
+        if op == "in_region":
+            return self.geometry.contains_points(region, args[0], args[1], value)
+        if op == "region_distance":
+            return self.geometry.distances(region, args[0], args[1])
+        if op == "box_in_region":
+            x, y, h, length, width = args
+            shrink = 2 * self.position_tolerance
+            return self.geometry.contains_boxes(region, x, y, h, length - shrink, width - shrink, value)
+        if op == "box_visible":
+            return self.geometry.boxes_meet_oriented(region, *args, value)
+        if op == "boxes_overlap":
+            from .shapes import boxes_overlap
+
+            shrink = 2 * self.position_tolerance
+            a = (*args[:3], args[3] - shrink, args[4] - shrink)
+            b = (*args[5:8], args[8] - shrink, args[9] - shrink)
+            return boxes_overlap(a, b)
+        if op == "follow":
+            from .follow import follow_field
+
+            return follow_field(self, term)
+        raise ValueError(f"cannot evaluate {op}")
+
+    def _field(self, term: Term) -> np.ndarray:
+        x, y = self._args(term)
+        rows, headings = self.geometry.field_values(term.value, x, y, self.value)
+        if len(rows) != self.size or np.any(rows != np.arange(self.size)):
+            self.expand(rows)
+        return headings
+
+    # ---------------------------------------------------------------- affine forms
+    def affine(self, term: Term) -> Affine:
+        """The term as an affine form in the unknowns; raises :class:`NotAffine` otherwise."""
+        found = self.affine_memo.get(term)
+        if found is not None:
+            return found
+        if term in self.unknowns:
+            result = Affine(np.zeros(self.size), {term: np.ones(self.size)})
+        elif not self.depends_on_unknowns(term):
+            result = Affine(self.value(term), {})
+        else:
+            result = self._affine_op(term)
+        self.affine_memo[term] = result
+        return self.affine_memo[term]
+
+    def _affine_args(self, term: Term) -> list[Affine]:
+        for arg in term.args:
+            self.affine(arg)
+        return [self.affine_memo[arg] for arg in term.args]
+
+    def _affine_op(self, term: Term) -> Affine:
+        op = term.op
+        if op in ("add", "sub"):
+            a, b = self._affine_args(term)
+            return a.plus(b, 1.0 if op == "add" else -1.0)
+        if op == "neg":
+            return self._affine_args(term)[0].scaled(np.full(self.size, -1.0))
+        if op == "mul":
+            a, b = self._affine_args(term)
+            if a.coefs and b.coefs:
+                raise NotAffine("product of unknowns")
+            return b.scaled(a.const) if not a.coefs else a.scaled(b.const)
+        if op == "div":
+            a, b = self._affine_args(term)
+            if b.coefs:
+                raise NotAffine("division by an unknown")
+            return a.scaled(1.0 / b.const)
+        if op == "select":
+            parts = self._affine_args(term)[1:]
+            index = self.value(term.args[0]).astype(np.intp)
+            result = Affine(np.zeros(self.size), {})
+            for k, part in enumerate(parts):
+                result = result.plus(part.scaled((index == k).astype(float)))
+            return result
+        raise NotAffine(f"{op} of an unknown")
+
+
+def _value_terms(value: object) -> list[Term]:
+    terms = getattr(value, "terms", None)
+    if callable(terms):
+        return list(terms())
+    if isinstance(value, tuple):
+        return [t for item in value for t in _value_terms(item)]
+    return []

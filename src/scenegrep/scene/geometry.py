@@ -1,0 +1,269 @@
+"""The meaning of regions and fields over a concrete road map, for arrays of known points.
+
+:class:`MapGeometry` answers the geometric terms of :mod:`.terms` for arrays of
+rows, given a function ``value(term)`` that evaluates a region's term
+parameters for the same rows:
+
+* points in a region (map layers by R-tree point-in-polygon, exact; sectors
+  analytically; a curb point lies within 1 µm of a curb polyline);
+* whether a small axis-aligned box (a point known up to the position
+  tolerance) meets a region — sound: never False when the box meets it;
+* oriented boxes inside a region (Scenic's ``containsObject``);
+* distances to regions; the headings of a field at points — several where
+  lanes overlap (intersections), each a possible value of Scenic's
+  ``roadDirection`` there (Scenic picks one arbitrarily); off every lane the
+  direction of the nearest lane.
+
+Layers a map does not hold (sidewalks, crossings, curbs and shoulders may be
+missing) are reported by :meth:`MapGeometry.missing_layers`; callers decide
+whether that is an error or an unknown.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import cached_property
+
+import numpy as np
+import shapely
+from shapely import STRtree
+
+from ..errors import UserError
+from ..model import RoadMap
+from ..model.geometry import box_corners
+from . import shapes
+from .regions import (
+    Difference,
+    Everywhere,
+    Field,
+    Intersection,
+    LaneAt,
+    LaneDirection,
+    MapField,
+    MapRegion,
+    Nowhere,
+    Region,
+    Sector,
+    Union,
+)
+from .terms import Term
+
+Values = Callable[[Term], np.ndarray]
+
+CURB_REACH_M = 1e-6
+"""A point is on a curb when it lies within this distance of a curb polyline."""
+
+OPTIONAL_LAYERS = ("sidewalk", "crossing", "curb", "shoulder")
+"""Layers some maps lack; lanes, the drivable area, roads and intersections are always known."""
+
+
+class MapGeometry:
+    """Geometric queries over one road map (or none: only map-free regions then)."""
+
+    def __init__(self, road_map: RoadMap | None):
+        self.map = road_map
+
+    # ---------------------------------------------------------------- layers
+    def missing_layers(self, layers: set[str]) -> set[str]:
+        """The layers among ``layers`` the map does not hold."""
+        if self.map is None:
+            return set(layers)
+        present = {
+            "sidewalk": bool(self.map.sidewalks),
+            "crossing": bool(self.map.crosswalks),
+            "curb": bool(self.map.curbs),
+            "shoulder": False,
+        }
+        return {layer for layer in layers if not present.get(layer, True)}
+
+    def _require_map(self) -> RoadMap:
+        if self.map is None:
+            raise UserError("the query uses map regions, but the data has no road map (give one with --map)")
+        return self.map
+
+    @cached_property
+    def _layer_parts(self) -> dict[str, np.ndarray]:
+        road_map = self._require_map()
+        parts = {
+            "drivable": [road_map.drivable],
+            "road": [a.polygon for a in road_map.roads] or list(road_map.lane_polygons),
+            "lane": list(road_map.lane_polygons),
+            "intersection": [a.polygon for a in road_map.intersections]
+            + list(road_map.lane_polygons[road_map.lane_is_intersection]),
+            "crossing": [a.polygon for a in road_map.crosswalks],
+            "sidewalk": [a.polygon for a in road_map.sidewalks],
+            "curb": list(road_map.curb_polylines.geometries),
+            "shoulder": [],
+        }
+        return {name: np.array([g for g in geoms if not g.is_empty], dtype=object) for name, geoms in parts.items()}
+
+    @cached_property
+    def _trees(self) -> dict[str, STRtree]:
+        return {name: STRtree(parts) for name, parts in self._layer_parts.items()}
+
+    @cached_property
+    def _unions(self) -> dict[str, shapely.Geometry]:
+        unions = {}
+        for name, parts in self._layer_parts.items():
+            union = shapely.union_all(parts) if len(parts) else shapely.GeometryCollection()
+            shapely.prepare(union)
+            unions[name] = union
+        return unions
+
+    def _layer_hits(self, layer: str, geometries: np.ndarray, predicate: str) -> np.ndarray:
+        hit = np.zeros(len(geometries), dtype=bool)
+        if len(self._layer_parts[layer]):
+            hit[self._trees[layer].query(geometries, predicate=predicate)[0]] = True
+        return hit
+
+    # ---------------------------------------------------------------- points
+    def contains_points(self, region: Region, x: np.ndarray, y: np.ndarray, value: Values) -> np.ndarray:
+        """Whether each point (x[i], y[i]) lies in the region (boundary included)."""
+        return self.boxes_meet(region, x, x, y, y, value)
+
+    def boxes_meet(
+        self, region: Region, x_lo: np.ndarray, x_hi: np.ndarray, y_lo: np.ndarray, y_hi: np.ndarray, value: Values
+    ) -> np.ndarray:
+        """Whether the axis-aligned box [x_lo, x_hi] x [y_lo, y_hi] of each row may meet the region.
+
+        Exact for map layers and degenerate boxes (points); for sectors and combinations of
+        regions it may say True for a box that misses the region by at most its diagonal.
+        """
+        n = len(x_lo)
+        if isinstance(region, Everywhere):
+            return np.ones(n, dtype=bool)
+        if isinstance(region, Nowhere):
+            return np.zeros(n, dtype=bool)
+        if isinstance(region, MapRegion):
+            boxes = shapely.box(x_lo, y_lo, x_hi, y_hi)
+            if region.layer == "curb":
+                boxes = shapely.buffer(boxes, CURB_REACH_M, cap_style="square", join_style="mitre")
+            return self._layer_hits(region.layer, boxes, "intersects")
+        if isinstance(region, Sector):
+            cx, cy = (x_lo + x_hi) / 2, (y_lo + y_hi) / 2
+            reach = np.hypot(x_hi - x_lo, y_hi - y_lo) / 2
+            return shapes.points_near_sector(cx, cy, *(value(t) for t in region.terms()), reach)
+        if isinstance(region, LaneAt):
+            return self._boxes_meet_lane_of(x_lo, x_hi, y_lo, y_hi, value(region.x), value(region.y))
+        if isinstance(region, Intersection):
+            hit = np.ones(n, dtype=bool)
+            for part in region.parts:
+                hit &= self.boxes_meet(part, x_lo, x_hi, y_lo, y_hi, value)
+            return hit
+        if isinstance(region, Union):
+            hit = np.zeros(n, dtype=bool)
+            for part in region.parts:
+                hit |= self.boxes_meet(part, x_lo, x_hi, y_lo, y_hi, value)
+            return hit
+        if isinstance(region, Difference):
+            inside_removed = self._aligned_boxes_inside(region.removed, x_lo, x_hi, y_lo, y_hi, value)
+            return self.boxes_meet(region.base, x_lo, x_hi, y_lo, y_hi, value) & ~inside_removed
+        raise TypeError(f"unknown region {region!r}")
+
+    def _aligned_boxes_inside(self, region: Region, x_lo, x_hi, y_lo, y_hi, value: Values) -> np.ndarray:
+        """Whether each axis-aligned box lies wholly inside the region (used to exclude boxes)."""
+        x, y = (x_lo + x_hi) / 2, (y_lo + y_hi) / 2
+        return self.contains_boxes(region, x, y, np.zeros_like(x), y_hi - y_lo, x_hi - x_lo, value)
+
+    def _boxes_meet_lane_of(self, x_lo, x_hi, y_lo, y_hi, ax, ay) -> np.ndarray:
+        road_map = self._require_map()
+        rows, lanes = road_map.lanes_containing(ax, ay)
+        boxes = shapely.box(x_lo[rows], y_lo[rows], x_hi[rows], y_hi[rows])
+        hit = np.zeros(len(x_lo), dtype=bool)
+        hit[rows[shapely.intersects(road_map.lane_polygons[lanes], boxes)]] = True
+        return hit
+
+    # ---------------------------------------------------------------- oriented boxes
+    def contains_boxes(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
+        """Whether each oriented box lies inside the region (Scenic's ``containsObject``)."""
+        n = len(np.atleast_1d(x))
+        if isinstance(region, Everywhere):
+            return np.ones(n, dtype=bool)
+        if isinstance(region, Nowhere):
+            return np.zeros(n, dtype=bool)
+        if isinstance(region, Sector):
+            return shapes.boxes_in_sectors(x, y, heading, length, width, *(value(t) for t in region.terms()))
+        if isinstance(region, Intersection):
+            inside = np.ones(n, dtype=bool)
+            for part in region.parts:
+                inside &= self.contains_boxes(part, x, y, heading, length, width, value)
+            return inside
+        if isinstance(region, Difference):
+            base = self.contains_boxes(region.base, x, y, heading, length, width, value)
+            return base & ~self.boxes_meet_oriented(region.removed, x, y, heading, length, width, value)
+        polygons = _box_polygons(x, y, heading, length, width)
+        if isinstance(region, LaneAt):
+            road_map = self._require_map()
+            rows, lanes = road_map.lanes_containing(value(region.x), value(region.y))
+            inside = np.zeros(n, dtype=bool)
+            inside[rows[shapely.contains(road_map.lane_polygons[lanes], polygons[rows])]] = True
+            return inside
+        return shapely.contains(self._static_union(region), polygons)
+
+    def boxes_meet_oriented(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
+        """Whether each oriented box intersects the region (touching counts)."""
+        n = len(np.atleast_1d(x))
+        if isinstance(region, Everywhere):
+            return np.ones(n, dtype=bool)
+        if isinstance(region, Nowhere):
+            return np.zeros(n, dtype=bool)
+        if isinstance(region, Sector):
+            return shapes.boxes_meet_sectors(x, y, heading, length, width, *(value(t) for t in region.terms()))
+        if isinstance(region, Union):
+            hit = np.zeros(n, dtype=bool)
+            for part in region.parts:
+                hit |= self.boxes_meet_oriented(part, x, y, heading, length, width, value)
+            return hit
+        if isinstance(region, MapRegion):
+            return self._layer_hits(region.layer, _box_polygons(x, y, heading, length, width), "intersects")
+        raise UserError(f"testing whether an object meets {_describe(region)} is not supported")
+
+    def _static_union(self, region: Region) -> shapely.Geometry:
+        """The shapely geometry of a region built only from map layers."""
+        if isinstance(region, MapRegion):
+            self._require_map()
+            return self._unions[region.layer]
+        if isinstance(region, Union):
+            return shapely.union_all([self._static_union(p) for p in region.parts])
+        raise UserError(f"containment in {_describe(region)} is not supported")
+
+    # ---------------------------------------------------------------- distances and fields
+    def distances(self, region: Region, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Distance (m) from each point to the region (0 inside)."""
+        if isinstance(region, MapRegion):
+            return shapely.distance(self._unions[region.layer], shapely.points(x, y))
+        if isinstance(region, Union) and all(isinstance(p, MapRegion) for p in region.parts):
+            return np.min([self.distances(p, x, y) for p in region.parts], axis=0)
+        raise UserError(f"the distance to {_describe(region)} is not supported")
+
+    def field_values(self, field: Field, x: np.ndarray, y: np.ndarray, value: Values) -> tuple[np.ndarray, np.ndarray]:
+        """The possible headings of a field at each point, as (row index, heading) pairs sorted by row.
+
+        Every row has at least one value when the map has lanes (or curbs, for the curb field).
+        """
+        road_map = self._require_map()
+        if isinstance(field, MapField) and field.name == "curb":
+            if not len(road_map.curb_polylines):
+                raise UserError("the query uses the curb, but the road map has no curbs")
+            line = self._trees["curb"].nearest(shapely.points(x, y))
+            return np.arange(len(x)), road_map.curb_polylines.direction_at(line, x, y)
+        if isinstance(field, LaneDirection):
+            rows, lanes = road_map.lanes_containing(value(field.x), value(field.y))
+            return rows, road_map.centreline_polylines.direction_at(lanes, x[rows], y[rows])
+        rows, lanes = road_map.lanes_containing(x, y)
+        missing = np.setdiff1d(np.arange(len(x)), rows)
+        if len(missing) and len(road_map.lanes):
+            nearest = road_map._lane_tree.nearest(shapely.points(x[missing], y[missing]))
+            rows, lanes = np.concatenate([rows, missing]), np.concatenate([lanes, nearest])
+            order = np.argsort(rows, kind="stable")
+            rows, lanes = rows[order], lanes[order]
+        return rows, road_map.centreline_polylines.direction_at(lanes, x[rows], y[rows])
+
+
+def _box_polygons(x, y, heading, length, width) -> np.ndarray:
+    corners = box_corners(x, y, heading, length, width)
+    return shapely.polygons(corners)
+
+
+def _describe(region: Region) -> str:
+    return f"a region of kind {type(region).__name__}"

@@ -1,0 +1,152 @@
+"""Algorithm 1 of seed 003 over every frame of a trace at once.
+
+Rows are partial object correspondences (a frame, and the label state matched
+to each program object so far). Groups are checked in dependency order; a
+group first extends each row with every candidate for the program objects it
+brings in (same frame, compatible kind, not already used: the correspondence is
+injective), then keeps the rows its features and requirements admit. A failed
+row is never extended again, which is exactly the paper's pruning of
+correspondences that extend a known-bad partial one (badOCs), done breadth
+first and vectorised over frames. A frame matches when a row survives every
+group (and, with ``exact``, uses every label object in view).
+
+The program's ego corresponds to the trace's ego object when the trace names
+one (the sensor platform); ``visible_distance`` keeps only label objects whose
+centre is within that many metres of the ego, and restricts random points to
+that disc around it (seed 003's crop of the map).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..model import LabelTrace, RoadMap
+from .decide import Tolerance, decide
+from .dependencies import Group
+from .evaluate import Evaluator, Labels, Rows
+from .geometry import MapGeometry
+from .program import ProgramObject, SceneProgram
+
+
+@dataclass(frozen=True)
+class SceneOptions:
+    """How to match: tolerances, ``exact`` (surjective correspondence), visible distance (m)."""
+
+    tolerance: Tolerance = field(default_factory=Tolerance)
+    exact: bool = False
+    visible_distance: float | None = None
+
+
+@dataclass
+class TraceMatches:
+    """Per frame of one trace: matched or not, the first surviving correspondence (program object ->
+    label object id) and, for frames that fail, the index of the first group no row survived."""
+
+    matched: np.ndarray
+    correspondence: list[dict[str, str] | None]
+    failed_group: np.ndarray
+
+
+class Candidates:
+    """Label states each program object may correspond to, per frame (CSR arrays)."""
+
+    def __init__(self, trace: LabelTrace, options: SceneOptions):
+        states = trace.states
+        self.n_frames = trace.n_frames
+        self.kinds = trace.objects.kinds()[states.object]
+        self.frame = states.frame
+        self.ego_row = trace.object_index(trace.ego) if trace.ego is not None else None
+        visible = np.ones(len(states), dtype=bool)
+        if options.visible_distance is not None and self.ego_row is not None:
+            ego_state = self.ego_state_per_frame(states.object, states.frame)
+            has_ego = ego_state >= 0
+            ex = np.where(has_ego, states.x[np.maximum(ego_state, 0)], np.nan)
+            ey = np.where(has_ego, states.y[np.maximum(ego_state, 0)], np.nan)
+            dist = np.hypot(states.x - ex[states.frame], states.y - ey[states.frame])
+            visible = dist <= options.visible_distance
+        self.visible = visible
+        self.object = states.object
+
+    def ego_state_per_frame(self, objects: np.ndarray, frames: np.ndarray) -> np.ndarray:
+        """The state row of the trace's ego in each frame (-1 where absent)."""
+        found = np.full(self.n_frames, -1, dtype=np.intp)
+        rows = np.flatnonzero(objects == self.ego_row)
+        found[frames[rows]] = rows
+        return found
+
+    def for_object(self, obj: ProgramObject) -> tuple[np.ndarray, np.ndarray]:
+        """(CSR offsets per frame, state rows) of the candidates for a program object."""
+        eligible = self.visible.copy()
+        if obj.kinds is not None:
+            eligible &= np.isin(self.kinds, list(obj.kinds))
+        if obj.is_ego and self.ego_row is not None:
+            eligible &= self.object == self.ego_row
+        rows = np.flatnonzero(eligible)
+        offsets = np.searchsorted(self.frame[rows], np.arange(self.n_frames + 1), side="left")
+        return offsets, rows
+
+    def in_view(self) -> np.ndarray:
+        """Number of label objects in view per frame (for exact matching)."""
+        return np.bincount(self.frame[self.visible], minlength=self.n_frames)
+
+
+def extend(rows: Rows, name: str, offsets: np.ndarray, candidates: np.ndarray) -> Rows:
+    """Every row extended by every candidate of its frame not already used in the row."""
+    counts = offsets[rows.frame + 1] - offsets[rows.frame]
+    parent = np.repeat(np.arange(len(rows)), counts)
+    first = np.repeat(offsets[rows.frame] - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+    chosen = candidates[np.arange(len(parent)) + first] if len(parent) else np.zeros(0, np.intp)
+    grown = rows.take(parent)
+    keep = np.ones(len(parent), dtype=bool)
+    for used in grown.state.values():
+        keep &= used != chosen
+    grown.state[name] = chosen
+    return grown.take(np.flatnonzero(keep))
+
+
+def match_trace(
+    scene: SceneProgram, groups: list[Group], trace: LabelTrace, road_map: RoadMap | None, options: SceneOptions
+) -> TraceMatches:
+    """Algorithm 1 for every frame of ``trace`` (see the module docstring)."""
+    states = trace.states
+    labels = Labels(states.x, states.y, states.heading, states.length, states.width, dict(trace.attributes))
+    objects = {o.name: o for o in scene.objects}
+    geometry = MapGeometry(road_map)
+    candidates = Candidates(trace, options)
+    rows = Rows(np.arange(trace.n_frames), {})
+    failed = np.full(trace.n_frames, -1, dtype=np.intp)
+    for g, group in enumerate(groups):
+        for name in group.introduces:
+            rows = extend(rows, name, *candidates.for_object(objects[name]))
+        if len(rows):
+            ev = Evaluator(rows, labels, objects, geometry, position_tolerance=options.tolerance.position)
+            rows = rows.take(np.flatnonzero(decide(ev, group, options.tolerance)))
+        _record_failures(failed, rows, g)
+    if options.exact:
+        used = len(scene.objects)
+        rows = rows.take(np.flatnonzero(candidates.in_view()[rows.frame] == used))
+        _record_failures(failed, rows, len(groups))
+    matched = np.zeros(trace.n_frames, dtype=bool)
+    matched[rows.frame] = True
+    return TraceMatches(matched, _correspondences(rows, trace), failed)
+
+
+def _record_failures(failed: np.ndarray, rows: Rows, g: int) -> None:
+    alive = np.zeros(len(failed), dtype=bool)
+    alive[rows.frame] = True
+    failed[(~alive) & (failed < 0)] = g
+
+
+def _correspondences(rows: Rows, trace: LabelTrace) -> list[dict[str, str] | None]:
+    """The first surviving row of each frame, as program object -> label object id."""
+    found: list[dict[str, str] | None] = [None] * trace.n_frames
+    if not len(rows):
+        return found
+    frames, first = np.unique(rows.frame, return_index=True)
+    ids = trace.objects.id
+    objects = trace.states.object
+    for frame, row in zip(frames.tolist(), first.tolist()):
+        found[frame] = {name: str(ids[objects[states[row]]]) for name, states in rows.state.items()}
+    return found

@@ -1,0 +1,161 @@
+"""The scene query API: compile a Scenic program once, match it against labeled frames.
+
+>>> query = compile_scene(open("fig3.scenic").read(), "fig3.scenic")   # doctest: +SKIP
+>>> result = query.match(trace)                                        # doctest: +SKIP
+>>> result.frames()                                                    # doctest: +SKIP
+
+Compilation is parse (Scenic's parser) -> IR (adapter) -> resolution into
+feature terms -> dependency groups. Matching runs Algorithm 1 over every frame
+of a trace (:mod:`.match`). The road map is the trace's own, else ``map`` given
+here, else the program's ``param map``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UserError, at
+from ..model import LabelTrace, RoadMap
+from ..scenic.adapter import parse_program
+from .dependencies import Group, analyse
+from .geometry import MapGeometry
+from .match import SceneOptions, TraceMatches, match_trace
+from .program import Requirement, SceneProgram
+from .resolve import Resolver
+from .terms import Term, value_terms
+
+
+@dataclass
+class SceneResult:
+    """The answer for one trace: per-frame matches, correspondences, why frames failed, and which
+    soft requirements (``require[p]``) hold in matched frames."""
+
+    trace: LabelTrace
+    query: SceneQuery
+    matches: TraceMatches
+    soft: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def matched(self) -> np.ndarray:
+        return self.matches.matched
+
+    def frames(self) -> np.ndarray:
+        """Positions of the matching frames."""
+        return np.flatnonzero(self.matches.matched)
+
+    def failure(self, frame: int) -> str | None:
+        """For a frame that does not match, the first features (or requirement) no correspondence satisfied."""
+        g = int(self.matches.failed_group[frame])
+        if self.matches.matched[frame] or g < 0:
+            return None
+        if g >= len(self.query.groups):
+            return "the frame has label objects the program does not account for (exact match)"
+        return self.query.describe_group(g)
+
+
+@dataclass
+class SceneQuery:
+    """A compiled scene program: resolved features, their groups in order, soft requirements."""
+
+    program: SceneProgram
+    groups: list[Group]
+    soft: list[Requirement]
+
+    def describe_group(self, g: int) -> str:
+        group = self.groups[g]
+        parts = []
+        for name in group.introduces:
+            obj = self.program.object(name)
+            parts.append(f"{name} ({obj.class_name}, line {obj.span.line})")
+        checks = group.describe()
+        where = f" for {', '.join(parts)}" if parts else ""
+        return f"{checks}{where}"
+
+    def uses_map(self) -> bool:
+        return bool(_layers(self.program))
+
+    def match(
+        self, trace: LabelTrace, road_map: RoadMap | None = None, options: SceneOptions | None = None
+    ) -> SceneResult:
+        """Match every frame of ``trace`` (see :mod:`.match`)."""
+        options = options or SceneOptions()
+        road_map = self._map_for(trace, road_map)
+        groups = self._groups_for(MapGeometry(road_map))
+        return SceneResult(trace, self, match_trace(self.program, groups, trace, road_map, options))
+
+    def _map_for(self, trace: LabelTrace, road_map: RoadMap | None) -> RoadMap | None:
+        if road_map is not None or not self.uses_map():
+            return road_map
+        from ..readers import read_map
+
+        if trace.map_source is not None:
+            return read_map(trace.map_source)
+        if self.program.map_path is not None:
+            return read_map(self.program.map_path, "opendrive")
+        raise UserError(
+            f"the program uses road regions but trace {trace.name!r} has no road map; give one with --map",
+            at(self.program.program.filename),
+        )
+
+    def _groups_for(self, geometry: MapGeometry) -> list[Group]:
+        """The groups, without Scenic's implicit containment requirements in map layers this map lacks."""
+        missing = {
+            r for r in self.program.requirements if r.implicit and geometry.missing_layers(_term_layers(r.condition))
+        }
+        if not missing:
+            return self.groups
+        kept = [r for r in self.program.requirements if not r.soft and r not in missing]
+        return analyse(self.program, kept)
+
+
+def _term_layers(term: Term) -> set[str]:
+    """The map layers a term reads, through its regions, fields and random points."""
+    layers: set[str] = set()
+    seen: set[int] = set()
+    stack = [term]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        value = node.value[0].region if node.op == "point" else node.value
+        for item in value if isinstance(value, tuple) else (value,):
+            if hasattr(item, "layers"):
+                layers |= set(item.layers())
+            stack.extend(value_terms(item))
+        stack.extend(node.args)
+    return layers
+
+
+def _layers(program: SceneProgram) -> set[str]:
+    layers: set[str] = set()
+    for obj in program.objects:
+        for feature in obj.features:
+            layers |= _term_layers(feature.term)
+    for requirement in program.requirements:
+        layers |= _term_layers(requirement.condition)
+    return layers
+
+
+def compile_scene(text: str, filename: str = "<program>", visible_distance: float | None = None) -> SceneQuery:
+    """Compile Scenic source text into a :class:`SceneQuery` (errors are one-line :class:`UserError`)."""
+    program = parse_program(text, filename)
+    resolver = Resolver(program, visible_distance=visible_distance)
+    scene = resolver.run()
+    soft = [r for r in scene.requirements if r.soft]
+    return SceneQuery(scene, analyse(scene), soft)
+
+
+def load_scene(path: str | Path, visible_distance: float | None = None) -> SceneQuery:
+    """Compile a ``.scenic`` file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise UserError("no such file", at(path)) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise UserError(f"cannot read the program: {error}", at(path)) from None
+    return compile_scene(text, str(path), visible_distance)

@@ -1,0 +1,549 @@
+"""``new Class spec, ...``: Scenic 3.1.1's specifier resolution, in 2-D mode, over terms.
+
+Each specifier *specifies* some properties, each at a priority (1 is the
+strongest); a property is set by the specifier with the strongest priority for
+it, two at the same priority are an error, and class defaults fill what no
+specifier sets (``scenic/core/object_types.py: _resolveSpecifiers``). ``on R``
+may instead *modify* a position another specifier set: in 2-D this keeps the
+position and requires it to lie in R. The priorities and values below are
+those of ``scenic/syntax/veneer.py``; the object's heading is
+``parentOrientation + yaw``, except that the facing specifiers fix the heading
+itself (Scenic computes the yaw that produces it).
+
+Values a specifier computes may read properties of the object being built
+(``self``): a scene object's position, heading and size read as its observed
+label values (conditioning), its other properties as their defining terms.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from ..scenic import ir
+from . import expressions as E
+from . import vectors as V
+from .domain import CLASSES, default_expression, defaulted_properties
+from .program import HEADING_FEATURE, Feature, ProgramObject, Requirement
+from .regions import (
+    Difference,
+    Everywhere,
+    Field,
+    Intersection,
+    Region,
+    Sector,
+    has_unknown_orientation,
+    orientation_of,
+)
+from .terms import RandomPoint, RandomVariable, Term
+from .values import Delayed, Instance, SelfView, Vec, observed_view, type_name
+
+if TYPE_CHECKING:
+    from .resolve import Resolver
+
+
+@dataclass(frozen=True)
+class AbsoluteHeading:
+    """A yaw given as the heading it must produce (``facing``): heading = the term itself."""
+
+    heading: Term
+
+
+@dataclass(eq=False)
+class Effect:
+    """What one specifier does: properties at priorities, and their values computed from ``self``."""
+
+    name: str
+    priorities: dict[str, int]
+    compute: Callable[[Any], dict[str, Any]]
+    node: ir.Node
+    modifies: frozenset[str] = frozenset()
+    _values: dict[str, Any] | None = field(default=None, repr=False)
+
+    def values(self, view: Any) -> dict[str, Any]:
+        if self._values is None:
+            self._values = self.compute(view)
+        return self._values
+
+
+class Builder(SelfView):
+    """Resolves the properties of one instance on demand, detecting cycles."""
+
+    def __init__(self, r: Resolver, instance: Instance, sources: dict[str, Effect | ir.Node]):
+        self.r = r
+        self.instance = instance
+        self.sources = sources
+        self.values: dict[str, Any] = {}
+        self.pending: set[str] = set()
+
+    def get(self, prop: str) -> Any:
+        """``self.prop`` while the instance is being built."""
+        if prop in self.instance.observed:
+            return self.instance.observed[prop]
+        if prop in ("heading", "orientation"):
+            return heading_of_instance(self.r, self)
+        return self.value(prop)
+
+    def value(self, prop: str) -> Any:
+        if prop in self.values:
+            return self.values[prop]
+        if prop not in self.sources:
+            raise self.r.error(f"{self.instance.spec.name} has no property {prop!r}", self.instance.span)
+        if prop in self.pending:
+            raise self.r.error(f"the property {prop!r} depends on itself", self.instance.span)
+        self.pending.add(prop)
+        source = self.sources[prop]
+        outer, self.r.self_view = self.r.self_view, self
+        try:
+            is_effect = isinstance(source, Effect)
+            result = source.values(self)[prop] if is_effect else self.r.evaluate(source, name=None)  # type: ignore[union-attr, arg-type]
+            result = result.compute(self) if isinstance(result, Delayed) else result
+        finally:
+            self.r.self_view = outer
+            self.pending.discard(prop)
+        self.values[prop] = result
+        return result
+
+
+def heading_of_instance(r: Resolver, b: Builder) -> Term:
+    """The heading a point or object gets: its absolute facing, else parentOrientation + yaw."""
+    yaw = b.value("yaw")
+    if isinstance(yaw, AbsoluteHeading):
+        return yaw.heading
+    parent = E.to_heading(r, b.value("parentOrientation"), b.instance.span)
+    return r.f.op("add", parent, E.to_num(r, yaw, b.instance.span, "a yaw"))
+
+
+# ---------------------------------------------------------------------------- construction
+def construct(r: Resolver, node: ir.New, name: str) -> Instance:
+    """Build the instance a ``new`` creates; scene objects join the scene program."""
+    spec = CLASSES.get(node.class_name)
+    if spec is None:
+        known = ", ".join(sorted(CLASSES))
+        raise r.error(f"unknown class {node.class_name!r}; a query knows {known}", node)
+    instance = Instance(name, spec, node.span)
+    if spec.is_object:
+        instance.observed = observed_view(r.f, name)
+    effects = [_effect(r, s) for s in node.specifiers]
+    chosen, modifiers = _choose(r, effects)
+    sources: dict[str, Effect | ir.Node] = dict(chosen)
+    for prop in defaulted_properties(spec.name):
+        if prop not in sources:
+            sources[prop] = default_expression(spec.name, prop)  # type: ignore[assignment]
+    builder = Builder(r, instance, sources)
+    for prop in sources:
+        instance.defining[prop] = builder.value(prop)
+    instance.defining["heading"] = heading_of_instance(r, builder)
+    if isinstance(instance.defining["yaw"], AbsoluteHeading):
+        parent = E.to_heading(r, instance.defining["parentOrientation"], node)
+        instance.defining["yaw"] = r.f.op("wrap", r.f.op("sub", instance.defining["heading"], parent))
+    _check_types(r, instance, node)
+    r.instances.append(instance)
+    if spec.is_object:
+        _add_scene_object(r, instance, chosen, modifiers, node)
+    return instance
+
+
+def _choose(r: Resolver, effects: list[Effect]) -> tuple[dict[str, Effect], list[Effect]]:
+    """The specifier setting each property (strongest priority), and the modifying specifiers."""
+    chosen: dict[str, Effect] = {}
+    seen_names: set[str] = set()
+    for effect in effects:
+        if effect.name in seen_names and effect.name != "with":
+            raise r.error(f"the specifier '{effect.name}' is used twice", effect.node)
+        seen_names.add(effect.name)
+    modifiers = []
+    for effect in sorted(effects, key=lambda e: bool(e.modifies)):
+        for prop, priority in effect.priorities.items():
+            current = chosen.get(prop)
+            if current is None or priority < current.priorities[prop]:
+                chosen[prop] = effect
+            elif prop in effect.modifies:
+                modifiers.append(effect)
+            elif priority == current.priorities[prop]:
+                raise r.error(
+                    f"property {prop!r} is specified twice (by '{current.name}' and '{effect.name}')", effect.node
+                )
+    return chosen, modifiers
+
+
+def _check_types(r: Resolver, instance: Instance, node: ir.New) -> None:
+    expected = {"position": Vec, "regionContainedIn": (Region, Term)}
+    for prop, kind in expected.items():
+        value = instance.defining.get(prop)
+        if value is not None and not isinstance(value, kind):
+            raise r.error(f"the {prop} of a {instance.spec.name} cannot be {type_name(value)}", node)
+
+
+def _add_scene_object(
+    r: Resolver, obj: Instance, chosen: dict[str, Effect], modifiers: list[Effect], node: ir.New
+) -> None:
+    position: Vec = obj.defining["position"]
+    features = [
+        Feature(obj.name, "x", position.x, obj.observed["position"].x, node.span),
+        Feature(obj.name, "y", position.y, obj.observed["position"].y, node.span),
+        Feature(obj.name, HEADING_FEATURE, obj.defining["heading"], obj.observed["heading"], node.span),
+    ]
+    for size in ("width", "length"):
+        effect = chosen.get(size)
+        if effect is not None and effect.name == "with":
+            value = E.to_num(r, obj.defining[size], effect.node)
+            features.append(Feature(obj.name, size, value, obj.observed[size], effect.node.span))
+    default_size = {}
+    for size in ("width", "length"):
+        default = r.evaluate(default_expression(obj.spec.name, size), name=None)
+        default_size[size] = float(default.value)
+    r.scene.objects.append(
+        ProgramObject(obj.name, obj.spec.name, obj.spec.kinds, tuple(features), default_size, obj.span)
+    )
+    _add_implicit_requirements(r, obj, modifiers, node)
+
+
+def _add_implicit_requirements(r: Resolver, obj: Instance, modifiers: list[Effect], node: ir.New) -> None:
+    """Scenic's default requirements of a scene object (``Scenario.generateDefaultRequirements``)."""
+    box = E.box_terms(obj)
+    container = obj.defining.get("regionContainedIn")
+    if isinstance(container, Region) and not isinstance(container, Everywhere):
+        term = r.f.op("box_in_region", *box, value=container, kind="bool")
+        _implicit(r, term, f"{obj.name} lies inside its regionContainedIn", node)
+    require_visible = obj.defining.get("requireVisible")
+    if obj.name != "ego" and isinstance(require_visible, Term) and require_visible.value is not False:
+        ego = r.scope.get("ego")
+        if ego is None:
+            raise r.error("requireVisible is set but no ego is defined before this object", node)
+        visible = E.sees(r, E.visible_region(r, ego, node), obj, node)
+        _implicit(
+            r,
+            r.f.op("or", r.f.op("not", require_visible, kind="bool"), visible, kind="bool"),
+            f"{obj.name} is visible from ego",
+            node,
+        )
+    for prop, negate in (("_observingEntity", False), ("_nonObservingEntity", True)):
+        if prop in obj.defining:
+            entity = obj.defining[prop]
+            visible = E.sees(r, E.visible_region(r, entity, node), obj, node)
+            word = "not visible" if negate else "visible"
+            term = r.f.op("not", visible, kind="bool") if negate else visible
+            _implicit(r, term, f"{obj.name} is {word} from {entity.name}", node)
+    for effect in modifiers:
+        region = effect.values(None)["region"]
+        inside = r.f.op("in_region", box[0], box[1], value=region, kind="bool")
+        _implicit(r, inside, f"{obj.name}'s position lies in the region of 'on'", effect.node)
+
+
+def _implicit(r: Resolver, term: Term, description: str, where: ir.Node | ir.Span) -> None:
+    span = where if isinstance(where, ir.Span) else where.span
+    r.scene.requirements.append(Requirement(term, description, span, implicit=True))
+
+
+def add_collision_requirements(r: Resolver) -> None:
+    """No two scene objects' boxes intersect unless one allows collisions."""
+    objects = [i for i in r.instances if i.is_object]
+    for i, a in enumerate(objects):
+        for b in objects[i + 1 :]:
+            overlap = r.f.op("boxes_overlap", *E.box_terms(a), *E.box_terms(b), kind="bool")
+            allowed = r.f.op("or", a.defining["allowCollisions"], b.defining["allowCollisions"], kind="bool")
+            term = r.f.op("or", allowed, r.f.op("not", overlap, kind="bool"), kind="bool")
+            if not (term.is_const and term.value is True):
+                _implicit(r, term, f"{a.name} and {b.name} do not intersect", a.span)
+
+
+def oriented_point(r: Resolver, node: ir.Node, position: Vec, heading: Term) -> Instance:
+    """An OrientedPoint value made by an operator (``follow``, ``front of``)."""
+    spec = CLASSES["OrientedPoint"]
+    point = Instance(f"OrientedPoint@{node.span.line}", spec, node.span)
+    point.defining.update(
+        position=position,
+        heading=heading,
+        parentOrientation=heading,
+        yaw=r.f.const(0),
+        visibleDistance=r.f.const(50),
+        viewAngle=r.f.const(math.tau),
+        width=r.f.const(0),
+        length=r.f.const(0),
+    )
+    return point
+
+
+# ---------------------------------------------------------------------------- specifiers
+def _effect(r: Resolver, node: ir.Specifier) -> Effect:
+    operands = [None if o is None else E.evaluate(r, o) for o in node.operands]
+    return _SPECIFIERS[node.name](r, node, operands)
+
+
+def _op_node(node: ir.Specifier, i: int) -> ir.Node:
+    return node.operands[i] or node
+
+
+def _with(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    prop = node.property or ""
+    if prop == "heading":
+        return _facing(r, node, ops)
+    if prop in ("position", "x", "y"):
+        value = ops[0]
+        return Effect("with", {prop: 1}, lambda view: {prop: E.to_vec(r, value, _op_node(node, 0))}, node)
+    return Effect("with", {prop: 1}, lambda view: {prop: ops[0]}, node)
+
+
+def _at(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    position = E.to_vec(r, ops[0], _op_node(node, 0))
+    return Effect("at", {"position": 1}, lambda view: {"position": position}, node)
+
+
+def random_point(r: Resolver, region: Region, node: ir.Node, description: str) -> Vec:
+    """A point drawn uniformly from ``region`` (cropped to the visible distance around the ego, if set)."""
+    if r.visible_distance is not None:
+        ego_x, ego_y = r.f.observed("ego", "x"), r.f.observed("ego", "y")
+        disc = Sector(ego_x, ego_y, r.f.const(r.visible_distance), r.f.const(0), r.f.const(math.tau))
+        region = Intersection((region, disc))
+    x, y = r.f.point(RandomPoint(f"{description}@{node.span.line}:{node.span.column}", region, node.span))
+    return Vec(x, y)
+
+
+def _own_position(view: Any, point: Vec) -> Vec:
+    """The position a specifier's orientation is taken at: the object's (observed for scene
+    objects), or the point this specifier is drawing when it is the one setting the position."""
+    if not view.instance.is_object and "position" in view.pending:
+        return point
+    return view.get("position")
+
+
+def _orientation_value(r: Resolver, region: Region, position: Vec, node: ir.Node) -> Term:
+    """The region's preferred orientation at ``position``."""
+    if has_unknown_orientation(region):
+        return r.f.var(
+            RandomVariable(
+                f"orientation of the region@{node.span.line}", r.f.const(-math.inf), r.f.const(math.inf), node.span
+            )
+        )
+    field_value = orientation_of(region)
+    assert field_value is not None
+    return E.field_at(r, field_value, position)
+
+
+def _is_oriented_region(region: Region) -> bool:
+    return orientation_of(region) is not None or has_unknown_orientation(region)
+
+
+def _in(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    region = E.to_region(r, ops[0], _op_node(node, 0))
+    priorities = {"position": 1}
+    if node.name == "contained in":
+        priorities["regionContainedIn"] = 1
+    if _is_oriented_region(region):
+        priorities["parentOrientation"] = 3
+
+    def compute(view: Any) -> dict[str, Any]:
+        point = random_point(r, region, node, f"point {node.name}")
+        values: dict[str, Any] = {"position": point, "regionContainedIn": region}
+        if "parentOrientation" in priorities:
+            values["parentOrientation"] = _orientation_value(r, region, _own_position(view, point), node)
+        return values
+
+    return Effect(node.name, priorities, compute, node)
+
+
+def _on(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    target = ops[0]
+    if isinstance(target, Instance):
+        raise r.error("'on <object>' places objects on 3-D surfaces; not supported in 2-D queries", node)
+    if isinstance(target, (Vec, tuple)):
+        return _at(r, node, ops)
+    region = E.to_region(r, target, _op_node(node, 0))
+    priorities = {"position": 1}
+    if _is_oriented_region(region):
+        priorities["parentOrientation"] = 2
+
+    def compute(view: Any) -> dict[str, Any]:
+        values: dict[str, Any] = {"region": region}
+        if view is not None:
+            point = random_point(r, region, node, "point on")
+            values["position"] = point
+            if "parentOrientation" in priorities:
+                values["parentOrientation"] = _orientation_value(r, region, _own_position(view, point), node)
+        return values
+
+    return Effect("on", priorities, compute, node, modifies=frozenset({"position"}))
+
+
+def _ego_of(r: Resolver, node: ir.Node) -> Instance:
+    ego = r.scope.get("ego")
+    if ego is None:
+        raise r.error("this specifier refers to ego, which is not defined yet", node)
+    return ego
+
+
+def _offset_by(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    ego = _ego_of(r, node)
+    offset = E.to_vec(r, ops[0], _op_node(node, 0))
+    position = V.offset_locally(r.f, ego.get("position"), ego.get("heading"), offset)
+    values = {"position": position, "parentOrientation": ego.get("heading")}
+    return Effect("offset by", {"position": 1, "parentOrientation": 3}, lambda view: values, node)
+
+
+def _offset_along(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    ego = _ego_of(r, node)
+    base = ego.get("position")
+    direction = ops[0]
+    heading = E.field_at(r, direction, base) if isinstance(direction, Field) else E.to_heading(r, direction, node)
+    position = V.offset_locally(r.f, base, heading, E.to_vec(r, ops[1], _op_node(node, 1)))
+    values = {"position": position, "parentOrientation": ego.get("heading")}
+    return Effect("offset along", {"position": 1, "parentOrientation": 3}, lambda view: values, node)
+
+
+_DIRECTIONS = {
+    # name: (axis of self's size, sign along x, sign along y, scalar distance is along x?)
+    "left of": ("width", -1, 0, True),
+    "right of": ("width", 1, 0, True),
+    "ahead of": ("length", 0, 1, False),
+    "behind": ("length", 0, -1, False),
+}
+
+
+def _direction(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    """``left of / right of / ahead of / behind X [by D]`` (veneer.directionalSpecHelper)."""
+    axis, sx, sy, along_x = _DIRECTIONS[node.name]
+    reference, distance = ops
+    f = r.f
+    if distance is None:
+        dx = dy = f.const(0)
+    elif isinstance(distance, Term) and distance.kind == "num":
+        dx, dy = (distance, f.const(0)) if along_x else (f.const(0), distance)
+    else:
+        vector = E.to_vec(r, distance, _op_node(node, 1))
+        dx, dy = vector.x, vector.y
+
+    def offset(view: Any, ref_size: Term) -> Vec:
+        half = f.op("mul", E.to_num(r, view.get(axis), node), f.const(0.5))
+        reach = f.op("add", half, f.op("mul", ref_size, f.const(0.5)))
+        if sx:
+            return Vec(f.op("mul", f.const(sx), f.op("add", reach, dx)), dy)
+        return Vec(dx, f.op("mul", f.const(sy), f.op("add", reach, dy)))
+
+    if isinstance(reference, Instance) and reference.spec.name != "Point":
+        ref_size = reference.get(axis) if reference.is_object else f.const(0)
+        origin, heading = reference.get("position"), reference.get("heading")
+
+        def relative(view: Any) -> dict[str, Any]:
+            return {
+                "position": V.offset_locally(f, origin, heading, offset(view, ref_size)),
+                "parentOrientation": heading,
+            }
+
+        return Effect(node.name, {"position": 1, "parentOrientation": 3}, relative, node)
+    origin = E.to_vec(r, reference, _op_node(node, 0))
+
+    def absolute(view: Any) -> dict[str, Any]:
+        return {"position": V.offset_locally(f, origin, view.get("heading"), offset(view, f.const(0)))}
+
+    return Effect(node.name, {"position": 1}, absolute, node)
+
+
+def _beyond(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    target = E.to_vec(r, ops[0], _op_node(node, 0))
+    base = ops[2] if ops[2] is not None else _ego_of(r, node)
+    origin = E.to_vec(r, base, _op_node(node, 2))
+    offset = ops[1]
+    if isinstance(offset, Term) and offset.kind == "num":
+        offset = Vec(r.f.const(0), offset)
+    offset = E.to_vec(r, offset, _op_node(node, 1))
+    direction = V.heading_of(r.f, V.sub(r.f, target, origin))
+    values = {
+        "position": V.offset_locally(r.f, target, direction, offset),
+        "parentOrientation": base.get("heading") if E.is_oriented(base) else r.f.const(0),
+    }
+    return Effect("beyond", {"position": 1, "parentOrientation": 3}, lambda view: values, node)
+
+
+def _visible(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    base = ops[0] if ops[0] is not None else _ego_of(r, node)
+    sector = E.visible_region(r, base, _op_node(node, 0))
+    if node.name == "visible":
+        return Effect(
+            "visible",
+            {"position": 3, "_observingEntity": 1},
+            lambda view: {"position": random_point(r, sector, node, "visible point"), "_observingEntity": base},
+            node,
+        )
+
+    def hidden(view: Any) -> dict[str, Any]:
+        container = view.value("regionContainedIn")
+        region = container if isinstance(container, Region) else Everywhere()
+        point = random_point(r, Difference(region, sector), node, "hidden point")
+        return {"position": point, "_nonObservingEntity": base}
+
+    return Effect("not visible", {"position": 3, "_nonObservingEntity": 1}, hidden, node)
+
+
+def _following(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    field_value, base, distance = ops
+    if not isinstance(field_value, Field):
+        raise r.error(f"expected a vector field, got {type_name(field_value)}", _op_node(node, 0))
+    start = E.to_vec(r, base if base is not None else _ego_of(r, node), _op_node(node, 1))
+    position = E.follow(r, field_value, start, E.to_num(r, distance, _op_node(node, 2)))
+
+    def compute(view: Any) -> dict[str, Any]:
+        orientation = E.field_at(r, field_value, _own_position(view, position))
+        return {"position": position, "parentOrientation": orientation}
+
+    return Effect("following", {"position": 1, "parentOrientation": 3}, compute, node)
+
+
+def _facing(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    heading = ops[0]
+
+    def compute(view: Any) -> dict[str, Any]:
+        if isinstance(heading, Field):
+            return {"yaw": AbsoluteHeading(E.field_at(r, heading, view.get("position")))}
+        value = heading.compute(view) if isinstance(heading, Delayed) else heading
+        return {"yaw": AbsoluteHeading(E.to_heading(r, value, _op_node(node, 0)))}
+
+    return Effect("facing", {"yaw": 1}, compute, node)
+
+
+def _facing_toward(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    target = E.to_vec(r, ops[0], _op_node(node, 0))
+    away = node.name == "facing away from"
+
+    def compute(view: Any) -> dict[str, Any]:
+        position = view.get("position")
+        direction = V.sub(r.f, position, target) if away else V.sub(r.f, target, position)
+        return {"yaw": AbsoluteHeading(V.heading_of(r.f, direction))}
+
+    return Effect(node.name, {"yaw": 1}, compute, node)
+
+
+def _apparently_facing(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    heading = E.to_heading(r, ops[0], _op_node(node, 0))
+    base = E.to_vec(r, ops[1] if ops[1] is not None else _ego_of(r, node), _op_node(node, 1))
+
+    def compute(view: Any) -> dict[str, Any]:
+        angle = V.heading_of(r.f, V.sub(r.f, view.get("position"), base))
+        return {"yaw": r.f.op("add", angle, heading)}
+
+    return Effect("apparently facing", {"yaw": 1}, compute, node)
+
+
+_SPECIFIERS: dict[str, Callable[[Resolver, ir.Specifier, list[Any]], Effect]] = {
+    "with": _with,
+    "at": _at,
+    "in": _in,
+    "contained in": _in,
+    "on": _on,
+    "offset by": _offset_by,
+    "offset along": _offset_along,
+    "left of": _direction,
+    "right of": _direction,
+    "ahead of": _direction,
+    "behind": _direction,
+    "beyond": _beyond,
+    "visible": _visible,
+    "not visible": _visible,
+    "following": _following,
+    "facing": _facing,
+    "facing toward": _facing_toward,
+    "facing away from": _facing_toward,
+    "apparently facing": _apparently_facing,
+}

@@ -1,0 +1,1 @@
+"""The Scenic language front end shared by scene and scenario queries: Scenic parser -> adapter -> IR."""

@@ -1,0 +1,1 @@
+"""Synthetic labeled data generated with Scenic, for ground truth and benchmarks."""

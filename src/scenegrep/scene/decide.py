@@ -179,7 +179,8 @@ def _one_unknown(ev: Evaluator, constraints: list[Linear]) -> np.ndarray:
 def _angle_gap(lo: np.ndarray, hi: np.ndarray, target: np.ndarray) -> np.ndarray:
     """The smallest |wrap(v - target)| over v in [lo, hi] (0 when the interval reaches the target mod 2π)."""
     width = hi - lo
-    ahead = np.mod(target - lo, TWO_PI)  # from lo forward to the next copy of the target
+    with np.errstate(invalid="ignore"):
+        ahead = np.mod(target - lo, TWO_PI)  # from lo forward to the next copy of the target
     inside = (ahead <= width) | (width >= TWO_PI)
     return np.where(inside, 0.0, np.minimum(ahead - width, TWO_PI - ahead))
 

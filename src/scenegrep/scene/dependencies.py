@@ -168,7 +168,8 @@ def _groups(
                 item = items[i]
                 (group.features if isinstance(item, Feature) else group.requirements).append(item)
                 unknowns |= randoms[i]
-                for obj, _ in sorted(reads[i], key=lambda o: object_order[o[0]]):
+                scene_objects = [o for o in reads[i] if o[0] in object_order]
+                for obj, _ in sorted(scene_objects, key=lambda o: object_order[o[0]]):
                     if obj not in introduced:
                         introduced.add(obj)
                         group.introduces.append(obj)

@@ -109,15 +109,23 @@ def lineage(name: str) -> list[ClassSpec]:
     return chain
 
 
+@dataclass(frozen=True)
+class Default:
+    """A property default: its expression and the one-line program it was parsed from (for messages)."""
+
+    expression: ir.Node
+    program: ir.Program
+
+
 @cache
-def default_expression(class_name: str, prop: str) -> ir.Node | None:
-    """The IR of the default of ``prop`` for ``class_name`` (inherited), or None."""
+def default_expression(class_name: str, prop: str) -> Default | None:
+    """The default of ``prop`` for ``class_name`` (inherited), or None."""
     for spec in lineage(class_name):
         if prop in spec.defaults:
             program = parse_program(f"value = {spec.defaults[prop]}\n", f"<default {spec.name}.{prop}>")
             statement = program.statements[0]
             assert isinstance(statement, ir.Assign)
-            return statement.value
+            return Default(statement.value, program)
     return None
 
 

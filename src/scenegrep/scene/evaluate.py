@@ -13,13 +13,14 @@ the caller can accept a row when any copy is feasible.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..model.geometry import heading_of_vector, normalize_angle
 from .geometry import MapGeometry
-from .program import ProgramObject
+from .program import TRACE, ProgramObject
 from .regions import Region
 from .terms import Term
 
@@ -118,6 +119,8 @@ class Evaluator:
         self.origin = np.arange(len(rows))
         self.memo: dict[Term, np.ndarray] = {}
         self.affine_memo: dict[Term, Affine] = {}
+        self.notes: Counter[str] = Counter()
+        """Verdicts of the row solvers (``solver:status``), for reports."""
 
     @property
     def size(self) -> int:
@@ -195,6 +198,8 @@ class Evaluator:
         return self._geometry(term)
 
     def _observed(self, obj: str, feature: str) -> np.ndarray:
+        if obj == TRACE:
+            return np.full(self.size, self.labels.attributes[feature], dtype=object)
         states = self.rows.state[obj][self.origin]
         column = getattr(self.labels, feature)[states]
         if feature in ("width", "length"):

@@ -250,8 +250,7 @@ def _arity(r: Resolver, node: ir.Call, args: list[Any], *counts: int) -> None:
 
 
 def _variable(r: Resolver, node: ir.Call, low: Term, high: Term) -> Term:
-    text = f"{node.function}@{node.span.line}:{node.span.column}"
-    return r.f.var(RandomVariable(text, low, high, node.span))
+    return r.f.var(RandomVariable(r.label(node), low, high, node.span))
 
 
 def _range(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
@@ -309,7 +308,7 @@ def choose(r: Resolver, node: ir.Node, values: tuple[Any, ...]) -> Any:
         return values[0]
     if all(isinstance(v, Region) for v in values):
         return Union(values)
-    index = r.f.choice(FiniteChoice(f"Options@{node.span.line}:{node.span.column}", len(values), node.span))
+    index = r.f.choice(FiniteChoice(r.label(node), len(values), node.span))
     if all(isinstance(v, Term) for v in values) and len({v.kind for v in values}) == 1:
         return r.f.select(index, values)
     if all(isinstance(v, (Vec, tuple, Instance)) for v in values):

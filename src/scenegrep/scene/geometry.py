@@ -11,8 +11,10 @@ parameters for the same rows:
 * oriented boxes inside a region (Scenic's ``containsObject``);
 * distances to regions; the headings of a field at points — several where
   lanes overlap (intersections), each a possible value of Scenic's
-  ``roadDirection`` there (Scenic picks one arbitrarily); off every lane the
-  direction of the nearest lane.
+  ``roadDirection`` there (Scenic picks one arbitrarily); off every lane both
+  Scenic's default 0 (right outside the road network) and the nearest lane's
+  direction (on road or shoulder areas outside lanes, where Scenic uses that
+  element's own orientation).
 
 Layers a map does not hold (sidewalks, crossings, curbs and shoulders may be
 missing) are reported by :meth:`MapGeometry.missing_layers`; callers decide
@@ -21,6 +23,7 @@ whether that is an error or an unknown.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import cached_property
 
@@ -173,6 +176,55 @@ class MapGeometry:
         hit[rows[shapely.intersects(road_map.lane_polygons[lanes], boxes)]] = True
         return hit
 
+    def region_bounds(self, region: Region, value: Values) -> tuple[float, float, float, float] | None:
+        """(min x, min y, max x, max y) enclosing the region (one row of its parameters), None if empty."""
+        if isinstance(region, Nowhere):
+            return None
+        if isinstance(region, Everywhere):
+            return (-1e7, -1e7, 1e7, 1e7)
+        if isinstance(region, MapRegion):
+            union = self._unions[region.layer]
+            return None if union.is_empty else tuple(union.bounds)
+        if isinstance(region, Sector):
+            cx, cy, radius = (float(value(t)[0]) for t in (region.cx, region.cy, region.radius))
+            return (cx - radius, cy - radius, cx + radius, cy + radius)
+        if isinstance(region, LaneAt):
+            road_map = self._require_map()
+            lanes = road_map.lanes_containing(value(region.x)[:1], value(region.y)[:1])[1]
+            return tuple(shapely.total_bounds(road_map.lane_polygons[lanes])) if len(lanes) else None
+        if isinstance(region, Difference):
+            return self.region_bounds(region.base, value)
+        parts = [self.region_bounds(p, value) for p in region.parts]  # type: ignore[attr-defined]
+        if isinstance(region, Union):
+            present = [b for b in parts if b is not None]
+            if not present:
+                return None
+            return (
+                min(b[0] for b in present),
+                min(b[1] for b in present),
+                max(b[2] for b in present),
+                max(b[3] for b in present),
+            )
+        if any(b is None for b in parts):
+            return None
+        box = (max(b[0] for b in parts), max(b[1] for b in parts), min(b[2] for b in parts), min(b[3] for b in parts))
+        return box if box[0] <= box[2] and box[1] <= box[3] else None
+
+    def static_geometry(self, region: Region) -> shapely.Geometry | None:
+        """The region as one shapely geometry when it is made of map layers only, else None."""
+        if isinstance(region, MapRegion):
+            self._require_map()
+            return self._unions[region.layer]
+        if isinstance(region, (Union, Intersection)):
+            parts = [self.static_geometry(p) for p in region.parts]
+            if any(p is None for p in parts):
+                return None
+            return shapely.union_all(parts) if isinstance(region, Union) else shapely.intersection_all(parts)
+        if isinstance(region, Difference):
+            base, removed = self.static_geometry(region.base), self.static_geometry(region.removed)
+            return None if base is None or removed is None else shapely.difference(base, removed)
+        return None
+
     # ---------------------------------------------------------------- oriented boxes
     def contains_boxes(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         """Whether each oriented box lies inside the region (Scenic's ``containsObject``)."""
@@ -251,13 +303,151 @@ class MapGeometry:
             rows, lanes = road_map.lanes_containing(value(field.x), value(field.y))
             return rows, road_map.centreline_polylines.direction_at(lanes, x[rows], y[rows])
         rows, lanes = road_map.lanes_containing(x, y)
+        headings = road_map.centreline_polylines.direction_at(lanes, x[rows], y[rows])
         missing = np.setdiff1d(np.arange(len(x)), rows)
-        if len(missing) and len(road_map.lanes):
-            nearest = road_map._lane_tree.nearest(shapely.points(x[missing], y[missing]))
-            rows, lanes = np.concatenate([rows, missing]), np.concatenate([lanes, nearest])
-            order = np.argsort(rows, kind="stable")
-            rows, lanes = rows[order], lanes[order]
-        return rows, road_map.centreline_polylines.direction_at(lanes, x[rows], y[rows])
+        if len(missing):
+            rows, headings = _off_lane(road_map, x, y, missing, rows, headings)
+        return rows, headings
+
+    def _uniform_headings(
+        self, field: Field, x0: float, x1: float, y0: float, y1: float, value: Values
+    ) -> np.ndarray | None:
+        """The headings shared by a small box's corners and centre, or None when they differ."""
+        xs = np.array([x0, x1, x0, x1, (x0 + x1) / 2])
+        ys = np.array([y0, y0, y1, y1, (y0 + y1) / 2])
+        rows, headings = self.field_values(field, xs, ys, lambda t: np.repeat(value(t)[:1], 5))
+        sets = [np.unique(headings[rows == k]) for k in range(5)]
+        if all(len(s) == len(sets[0]) and np.array_equal(s, sets[0]) for s in sets[1:]):
+            return sets[0]
+        return None
+
+    @cached_property
+    def _intersection_areas(self) -> tuple[STRtree, list[np.ndarray]]:
+        """An R-tree of the intersection areas and, per area, its lanes' indices in the map's order."""
+        road_map = self._require_map()
+        index = road_map.lane_index
+        areas = list(road_map.intersections)
+        lanes = [np.array([index[lane] for lane in a.lanes if lane in index], dtype=np.intp) for a in areas]
+        return STRtree(np.array([a.polygon for a in areas], dtype=object)), lanes
+
+    def scenic_headings(self, field: Field, x: np.ndarray, y: np.ndarray, value: Values) -> np.ndarray:
+        """The one heading Scenic itself computes for the field at each point (used to walk along it).
+
+        Scenic's ``roadDirection`` takes the first intersection containing the point and, there, the
+        first of its connecting lanes (in maneuver order) containing it, else the nearest; elsewhere
+        the lane containing the point; outside every lane the nearest lane; outside the road network
+        0. Exact on OpenDRIVE maps, whose intersections keep Scenic's maneuver order.
+        """
+        rows, headings = self.field_values(field, x, y, value)
+        first = np.ones(len(rows), dtype=bool)
+        first[1:] = rows[1:] != rows[:-1]
+        chosen = np.zeros(len(x))
+        chosen[rows[first]] = headings[first]
+        if isinstance(field, MapField) and field.name == "lanes" and len(x):
+            self._intersection_choice(x, y, chosen)
+        return chosen
+
+    def _intersection_choice(self, x: np.ndarray, y: np.ndarray, chosen: np.ndarray) -> None:
+        road_map = self._require_map()
+        tree, area_lanes = self._intersection_areas
+        if not len(area_lanes):
+            return
+        points, areas = tree.query(shapely.points(x, y), predicate="intersects")
+        for point in np.unique(points).tolist():
+            lanes = area_lanes[int(areas[points == point].min())]
+            if not len(lanes):
+                continue
+            here = shapely.Point(x[point], y[point])
+            inside = shapely.intersects(road_map.lane_polygons[lanes], here)
+            lane = (
+                lanes[np.argmax(inside)]
+                if inside.any()
+                else lanes[np.argmin(shapely.distance(road_map.lane_polygons[lanes], here))]
+            )
+            chosen[point] = road_map.centreline_polylines.direction_at(
+                np.array([lane]), x[point : point + 1], y[point : point + 1]
+            )[0]
+
+    def field_headings_in_box(
+        self, field: Field, x0: float, x1: float, y0: float, y1: float, value: Values
+    ) -> np.ndarray:
+        """Every heading the field may take at a point of the box [x0, x1] x [y0, y1] (a superset).
+
+        A point's heading is that of the segment of a polyline (lane centreline or curb) nearest to
+        it; for any point of the box that segment lies within d + 2h of the box centre, where d is
+        the centre's distance to the polyline and h the half-diagonal, so those segments' headings
+        cover every point of the box.
+        """
+        road_map = self._require_map()
+        cx, cy, h = (x0 + x1) / 2, (y0 + y1) / 2, math.hypot(x1 - x0, y1 - y0) / 2
+        if h <= SMALL_BOX_M:
+            uniform = self._uniform_headings(field, x0, x1, y0, y1, value)
+            if uniform is not None:
+                return uniform
+        centre = shapely.Point(cx, cy)
+        if isinstance(field, MapField) and field.name == "curb":
+            polylines, tree = road_map.curb_polylines, self._trees["curb"]
+            nearest = shapely.distance(tree.geometries[tree.nearest(centre)], centre)
+            lines = tree.query(centre, predicate="dwithin", distance=nearest + 2 * h)
+            headings = []
+        elif isinstance(field, LaneDirection):
+            polylines = road_map.centreline_polylines
+            lines = road_map.lanes_containing(value(field.x)[:1], value(field.y)[:1])[1]
+            headings = []
+        else:
+            polylines = road_map.centreline_polylines
+            box = shapely.box(x0, y0, x1, y1)
+            lines = road_map._lane_tree.query(box, predicate="intersects")
+            if not self._unions["lane"].contains(box) and len(road_map.lanes):
+                nearest = shapely.distance(road_map.lane_polygons[road_map._lane_tree.nearest(centre)], centre)
+                lines = np.union1d(
+                    lines, road_map._lane_tree.query(centre, predicate="dwithin", distance=nearest + 2 * h)
+                )
+        headings = []
+        for line in np.asarray(lines, dtype=np.intp).tolist():
+            first, count = polylines.first[line], polylines.count[line]
+            segments = slice(first, first + count)
+            distance = _segment_distances(polylines.start[segments], polylines.end[segments], cx, cy)
+            if len(distance):
+                headings.append(polylines.heading[segments][distance <= distance.min() + 2 * h + 1e-9])
+        return np.concatenate(headings) if headings else np.zeros(0)
+
+
+SMALL_BOX_M = 0.01
+"""Boxes with a half-diagonal up to this (m) whose corners and centre all take the same headings
+are taken to lie in one cell of the field (cells are convex at that scale)."""
+
+
+def _off_lane(road_map: RoadMap, x, y, missing, rows, headings) -> tuple[np.ndarray, np.ndarray]:
+    """Road directions at points in no lane: Scenic's default 0 (outside every road element) and the
+    nearest lane's direction (standing in for a road or shoulder element's own orientation)."""
+    extra_rows = [missing]
+    extra = [np.zeros(len(missing))]
+    if len(road_map.lanes):
+        nearest = road_map._lane_tree.nearest(shapely.points(x[missing], y[missing]))
+        extra_rows.append(missing)
+        extra.append(road_map.centreline_polylines.direction_at(nearest, x[missing], y[missing]))
+    rows = np.concatenate([rows, *extra_rows])
+    headings = np.concatenate([headings, *extra])
+    order = np.argsort(rows, kind="stable")
+    return rows[order], headings[order]
+
+
+def _segment_distances(start: np.ndarray, end: np.ndarray, px: float, py: float) -> np.ndarray:
+    """Distance from (px, py) to each segment start[i]-end[i]."""
+    d = end - start
+    length2 = np.einsum("ij,ij->i", d, d)
+    t = np.clip(
+        np.divide(
+            (px - start[:, 0]) * d[:, 0] + (py - start[:, 1]) * d[:, 1],
+            length2,
+            out=np.zeros_like(length2),
+            where=length2 > 0,
+        ),
+        0,
+        1,
+    )
+    return np.hypot(start[:, 0] + t * d[:, 0] - px, start[:, 1] + t * d[:, 1] - py)
 
 
 def _box_polygons(x, y, heading, length, width) -> np.ndarray:

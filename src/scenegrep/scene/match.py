@@ -18,11 +18,12 @@ that disc around it (seed 003's crop of the map).
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import LabelTrace, RoadMap
+from ..model import LabelTrace
 from .decide import Tolerance, decide
 from .dependencies import Group
 from .evaluate import Evaluator, Labels, Rows
@@ -42,11 +43,16 @@ class SceneOptions:
 @dataclass
 class TraceMatches:
     """Per frame of one trace: matched or not, the first surviving correspondence (program object ->
-    label object id) and, for frames that fail, the index of the first group no row survived."""
+    label object id) and, for frames that fail, the index (into ``groups``, the groups checked) of
+    the first group no row survived; ``survivors`` holds the first surviving row of each matched
+    frame, in frame order; ``notes`` counts the row solvers' verdicts."""
 
     matched: np.ndarray
     correspondence: list[dict[str, str] | None]
     failed_group: np.ndarray
+    groups: list[Group]
+    survivors: Rows
+    notes: Counter = field(default_factory=Counter)
 
 
 class Candidates:
@@ -106,23 +112,29 @@ def extend(rows: Rows, name: str, offsets: np.ndarray, candidates: np.ndarray) -
     return grown.take(np.flatnonzero(keep))
 
 
+def labels_of(trace: LabelTrace) -> Labels:
+    """The label columns the scene query reads."""
+    states = trace.states
+    return Labels(states.x, states.y, states.heading, states.length, states.width, dict(trace.attributes))
+
+
 def match_trace(
-    scene: SceneProgram, groups: list[Group], trace: LabelTrace, road_map: RoadMap | None, options: SceneOptions
+    scene: SceneProgram, groups: list[Group], trace: LabelTrace, geometry: MapGeometry, options: SceneOptions
 ) -> TraceMatches:
     """Algorithm 1 for every frame of ``trace`` (see the module docstring)."""
-    states = trace.states
-    labels = Labels(states.x, states.y, states.heading, states.length, states.width, dict(trace.attributes))
+    labels = labels_of(trace)
     objects = {o.name: o for o in scene.objects}
-    geometry = MapGeometry(road_map)
     candidates = Candidates(trace, options)
     rows = Rows(np.arange(trace.n_frames), {})
     failed = np.full(trace.n_frames, -1, dtype=np.intp)
+    notes: Counter = Counter()
     for g, group in enumerate(groups):
         for name in group.introduces:
             rows = extend(rows, name, *candidates.for_object(objects[name]))
         if len(rows):
             ev = Evaluator(rows, labels, objects, geometry, position_tolerance=options.tolerance.position)
             rows = rows.take(np.flatnonzero(decide(ev, group, options.tolerance)))
+            notes.update(ev.notes)
         _record_failures(failed, rows, g)
     if options.exact:
         used = len(scene.objects)
@@ -130,7 +142,8 @@ def match_trace(
         _record_failures(failed, rows, len(groups))
     matched = np.zeros(trace.n_frames, dtype=bool)
     matched[rows.frame] = True
-    return TraceMatches(matched, _correspondences(rows, trace), failed)
+    survivors = rows.take(np.unique(rows.frame, return_index=True)[1])
+    return TraceMatches(matched, _correspondences(survivors, trace), failed, groups, survivors, notes)
 
 
 def _record_failures(failed: np.ndarray, rows: Rows, g: int) -> None:
@@ -139,14 +152,11 @@ def _record_failures(failed: np.ndarray, rows: Rows, g: int) -> None:
     failed[(~alive) & (failed < 0)] = g
 
 
-def _correspondences(rows: Rows, trace: LabelTrace) -> list[dict[str, str] | None]:
-    """The first surviving row of each frame, as program object -> label object id."""
+def _correspondences(survivors: Rows, trace: LabelTrace) -> list[dict[str, str] | None]:
+    """Each matched frame's surviving row, as program object -> label object id."""
     found: list[dict[str, str] | None] = [None] * trace.n_frames
-    if not len(rows):
-        return found
-    frames, first = np.unique(rows.frame, return_index=True)
     ids = trace.objects.id
     objects = trace.states.object
-    for frame, row in zip(frames.tolist(), first.tolist()):
-        found[frame] = {name: str(ids[objects[states[row]]]) for name, states in rows.state.items()}
+    for row, frame in enumerate(survivors.frame.tolist()):
+        found[frame] = {name: str(ids[objects[states[row]]]) for name, states in survivors.state.items()}
     return found

@@ -16,6 +16,9 @@ from dataclasses import dataclass, field
 from ..scenic import ir
 from .terms import Term, TermFactory
 
+TRACE = "@trace"
+"""The pseudo-object whose observed features are the trace's attributes (weather, time of day ...)."""
+
 POSITION_FEATURES = ("x", "y")
 HEADING_FEATURE = "heading"
 SIZE_FEATURES = ("width", "length")
@@ -61,13 +64,16 @@ class ProgramObject:
 @dataclass(frozen=True, eq=False)
 class Requirement:
     """A boolean term that must hold: a ``require`` (soft when its probability is below 1: reported,
-    not enforced) or an implicit requirement of Scenic (containment, visibility, no collision)."""
+    not enforced), an implicit requirement of Scenic (containment, visibility, no collision), or a
+    global parameter's value matching the trace attribute of the same name (``parameter``; checked
+    only for traces that have that attribute)."""
 
     condition: Term
     description: str
     span: ir.Span
     probability: float | None = None
     implicit: bool = False
+    parameter: str | None = None
 
     @property
     def soft(self) -> bool:

@@ -12,8 +12,10 @@ here, else the program's ``param map``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,7 +24,9 @@ from ..model import LabelTrace, RoadMap
 from ..scenic.adapter import parse_program
 from .dependencies import Group, analyse
 from .geometry import MapGeometry
-from .match import SceneOptions, TraceMatches, match_trace
+from .evaluate import Labels
+from .explain import soft_requirements, witness_values
+from .match import SceneOptions, TraceMatches, labels_of, match_trace
 from .program import Requirement, SceneProgram
 from .resolve import Resolver
 from .terms import Term, value_terms
@@ -30,13 +34,15 @@ from .terms import Term, value_terms
 
 @dataclass
 class SceneResult:
-    """The answer for one trace: per-frame matches, correspondences, why frames failed, and which
-    soft requirements (``require[p]``) hold in matched frames."""
+    """The answer for one trace: which frames match, with what correspondence, why the others fail,
+    the random values that reproduce a matched frame, and which soft requirements hold there."""
 
     trace: LabelTrace
     query: SceneQuery
     matches: TraceMatches
-    soft: dict[str, np.ndarray] = field(default_factory=dict)
+    labels: Labels
+    geometry: MapGeometry
+    options: SceneOptions
 
     @property
     def matched(self) -> np.ndarray:
@@ -46,14 +52,30 @@ class SceneResult:
         """Positions of the matching frames."""
         return np.flatnonzero(self.matches.matched)
 
+    def correspondence(self, frame: int) -> dict[str, str] | None:
+        """Program object -> label object id, for a matched frame."""
+        return self.matches.correspondence[frame]
+
     def failure(self, frame: int) -> str | None:
         """For a frame that does not match, the first features (or requirement) no correspondence satisfied."""
         g = int(self.matches.failed_group[frame])
         if self.matches.matched[frame] or g < 0:
             return None
-        if g >= len(self.query.groups):
+        if g >= len(self.matches.groups):
             return "the frame has label objects the program does not account for (exact match)"
-        return self.query.describe_group(g)
+        return self.query.describe_group(self.matches.groups[g])
+
+    def values(self, frame: int) -> dict[str, Any]:
+        """Random values reproducing a matched frame (see :func:`.explain.witness_values`)."""
+        survivor = int(np.searchsorted(self.matches.survivors.frame, frame))
+        return witness_values(
+            self.query.program, self.matches, self.labels, self.geometry, self.options.tolerance, survivor
+        )
+
+    @cached_property
+    def soft(self) -> dict[str, np.ndarray]:
+        """Soft requirement description -> whether it holds, per matched frame (in frame order)."""
+        return soft_requirements(self.query.program, self.matches, self.labels, self.geometry, self.options.tolerance)
 
 
 @dataclass
@@ -64,8 +86,8 @@ class SceneQuery:
     groups: list[Group]
     soft: list[Requirement]
 
-    def describe_group(self, g: int) -> str:
-        group = self.groups[g]
+    def describe_group(self, group: Group) -> str:
+        """The features and requirements of a group, and the program objects it brings in."""
         parts = []
         for name in group.introduces:
             obj = self.program.object(name)
@@ -83,8 +105,10 @@ class SceneQuery:
         """Match every frame of ``trace`` (see :mod:`.match`)."""
         options = options or SceneOptions()
         road_map = self._map_for(trace, road_map)
-        groups = self._groups_for(MapGeometry(road_map))
-        return SceneResult(trace, self, match_trace(self.program, groups, trace, road_map, options))
+        geometry = MapGeometry(road_map)
+        groups = self._groups_for(geometry, trace)
+        matches = match_trace(self.program, groups, trace, geometry, options)
+        return SceneResult(trace, self, matches, labels_of(trace), geometry, options)
 
     def _map_for(self, trace: LabelTrace, road_map: RoadMap | None) -> RoadMap | None:
         if road_map is not None or not self.uses_map():
@@ -100,15 +124,18 @@ class SceneQuery:
             at(self.program.program.filename),
         )
 
-    def _groups_for(self, geometry: MapGeometry) -> list[Group]:
-        """The groups, without Scenic's implicit containment requirements in map layers this map lacks."""
-        missing = {
-            r for r in self.program.requirements if r.implicit and geometry.missing_layers(_term_layers(r.condition))
+    def _groups_for(self, geometry: MapGeometry, trace: LabelTrace) -> list[Group]:
+        """The groups, without Scenic's implicit containment requirements in map layers this map lacks
+        and without parameter checks for attributes the trace does not have."""
+        dropped = {
+            r
+            for r in self.program.requirements
+            if (r.implicit and geometry.missing_layers(_term_layers(r.condition)))
+            or (r.parameter is not None and r.parameter not in trace.attributes)
         }
-        if not missing:
+        if not dropped:
             return self.groups
-        kept = [r for r in self.program.requirements if not r.soft and r not in missing]
-        return analyse(self.program, kept)
+        return analyse(self.program, [r for r in self.program.requirements if not r.soft and r not in dropped])
 
 
 def _term_layers(term: Term) -> set[str]:

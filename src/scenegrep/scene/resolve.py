@@ -17,11 +17,16 @@ from ..errors import UserError
 from ..scenic import ir
 from ..scenic.errors import program_error
 from . import expressions
-from .domain import MODELS
-from .program import Requirement, SceneProgram
+from .domain import MODELS, Default
+from .program import TRACE, Requirement, SceneProgram
 from .regions import Everywhere, MapField, MapRegion, Nowhere, Union
 from .terms import Term
 from .values import Instance, Namespace
+
+SIMULATOR_PARAMS = frozenset(
+    {"map", "map_options", "carla_map", "lgsvl_map", "render", "timestep", "time_step", "use2DMap"}
+)
+"""Parameters that configure Scenic or a simulator rather than describe the scene."""
 
 NETWORK = {
     "drivableRegion": MapRegion("drivable"),
@@ -107,8 +112,12 @@ class Resolver:
                 raise self.error("param map must be a file name", node.value)
             self.scene.map_path = value.value
         self.params[node.name] = value
-        if isinstance(value, Term) and value.kind in ("num", "str", "bool"):
+        if isinstance(value, Term) and value.kind in ("num", "str", "bool") and node.name not in SIMULATOR_PARAMS:
             self.scene.params[node.name] = value
+            observed = self.f.observed(TRACE, node.name, value.kind)
+            equal = self.f.op("eq", value, observed, kind="bool")
+            text = f"param {node.name} equals the trace's attribute {node.name}"
+            self.scene.requirements.append(Requirement(equal, text, node.span, parameter=node.name))
 
     def assign(self, node: ir.Assign) -> None:
         if node.name in DRIVING_NAMES or node.name in ("network", "globalParameters", "self"):
@@ -148,6 +157,14 @@ class Resolver:
             return construct(self, node, self.instance_name(node, name))
         return expressions.evaluate(self, node)
 
+    def evaluate_default(self, default: Default) -> Any:
+        """A class default's value; its messages and labels point into the default's own text."""
+        outer, self.program = self.program, default.program
+        try:
+            return self.evaluate(default.expression, name=None)
+        finally:
+            self.program = outer
+
     def instance_name(self, node: ir.New, name: str | None) -> str:
         base = f"{name}{self.suffix}" if name else f"{node.class_name}@{node.span.line}{self.suffix}"
         taken = {i.name for i in self.instances}
@@ -172,6 +189,14 @@ class Resolver:
         if node.id in ("pi", "tau"):
             return self.f.const(math.pi if node.id == "pi" else math.tau)
         raise self.error(f"unknown name {node.id!r}", node)
+
+    def label(self, node: ir.Node) -> str:
+        """How a random value is named in explanations: its source text and place, ``Range(4, 10)@2:36``."""
+        text = _source_text(self.program, node.span)
+        text = text if len(text) <= 40 else text[:37] + "..."
+        if self.program.filename.startswith("<default "):
+            return f"{text} ({self.program.filename[1:-1]}){self.suffix}"
+        return f"{text}@{node.span.line}:{node.span.column}{self.suffix}"
 
     def local_path(self, relative: str) -> str:
         """``localPath``: a path relative to the program's folder."""

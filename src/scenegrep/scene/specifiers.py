@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 from ..scenic import ir
 from . import expressions as E
 from . import vectors as V
-from .domain import CLASSES, default_expression, defaulted_properties
+from .domain import CLASSES, Default, default_expression, defaulted_properties
 from .program import HEADING_FEATURE, Feature, ProgramObject, Requirement
 from .regions import (
     Difference,
@@ -71,7 +71,7 @@ class Effect:
 class Builder(SelfView):
     """Resolves the properties of one instance on demand, detecting cycles."""
 
-    def __init__(self, r: Resolver, instance: Instance, sources: dict[str, Effect | ir.Node]):
+    def __init__(self, r: Resolver, instance: Instance, sources: dict[str, Effect | Default]):
         self.r = r
         self.instance = instance
         self.sources = sources
@@ -97,9 +97,10 @@ class Builder(SelfView):
         source = self.sources[prop]
         outer, self.r.self_view = self.r.self_view, self
         try:
-            is_effect = isinstance(source, Effect)
-            result = source.values(self)[prop] if is_effect else self.r.evaluate(source, name=None)  # type: ignore[union-attr, arg-type]
+            result = source.values(self)[prop] if isinstance(source, Effect) else self.r.evaluate_default(source)
             result = result.compute(self) if isinstance(result, Delayed) else result
+            if prop == "position" and isinstance(result, (Instance, tuple)):
+                result = E.to_vec(self.r, result, self.instance.span)  # a Point stands for its position
         finally:
             self.r.self_view = outer
             self.pending.discard(prop)
@@ -128,13 +129,16 @@ def construct(r: Resolver, node: ir.New, name: str) -> Instance:
         instance.observed = observed_view(r.f, name)
     effects = [_effect(r, s) for s in node.specifiers]
     chosen, modifiers = _choose(r, effects)
-    sources: dict[str, Effect | ir.Node] = dict(chosen)
+    sources: dict[str, Effect | Default] = dict(chosen)
     for prop in defaulted_properties(spec.name):
         if prop not in sources:
-            sources[prop] = default_expression(spec.name, prop)  # type: ignore[assignment]
+            sources[prop] = default_expression(spec.name, prop)  # type: ignore[assignment]  # defaulted: not None
     builder = Builder(r, instance, sources)
     for prop in sources:
         instance.defining[prop] = builder.value(prop)
+    if "yaw" not in sources:  # a Point has no orientation
+        r.instances.append(instance)
+        return instance
     instance.defining["heading"] = heading_of_instance(r, builder)
     if isinstance(instance.defining["yaw"], AbsoluteHeading):
         parent = E.to_heading(r, instance.defining["parentOrientation"], node)
@@ -193,7 +197,7 @@ def _add_scene_object(
             features.append(Feature(obj.name, size, value, obj.observed[size], effect.node.span))
     default_size = {}
     for size in ("width", "length"):
-        default = r.evaluate(default_expression(obj.spec.name, size), name=None)
+        default = r.evaluate_default(default_expression(obj.spec.name, size))  # type: ignore[arg-type]
         default_size[size] = float(default.value)
     r.scene.objects.append(
         ProgramObject(obj.name, obj.spec.name, obj.spec.kinds, tuple(features), default_size, obj.span)
@@ -298,7 +302,7 @@ def random_point(r: Resolver, region: Region, node: ir.Node, description: str) -
         ego_x, ego_y = r.f.observed("ego", "x"), r.f.observed("ego", "y")
         disc = Sector(ego_x, ego_y, r.f.const(r.visible_distance), r.f.const(0), r.f.const(math.tau))
         region = Intersection((region, disc))
-    x, y = r.f.point(RandomPoint(f"{description}@{node.span.line}:{node.span.column}", region, node.span))
+    x, y = r.f.point(RandomPoint(f"{description}: {r.label(node)}", region, node.span))
     return Vec(x, y)
 
 
@@ -313,11 +317,8 @@ def _own_position(view: Any, point: Vec) -> Vec:
 def _orientation_value(r: Resolver, region: Region, position: Vec, node: ir.Node) -> Term:
     """The region's preferred orientation at ``position``."""
     if has_unknown_orientation(region):
-        return r.f.var(
-            RandomVariable(
-                f"orientation of the region@{node.span.line}", r.f.const(-math.inf), r.f.const(math.inf), node.span
-            )
-        )
+        name = f"orientation of the region: {r.label(node)}"
+        return r.f.var(RandomVariable(name, r.f.const(-math.inf), r.f.const(math.inf), node.span))
     field_value = orientation_of(region)
     assert field_value is not None
     return E.field_at(r, field_value, position)
@@ -442,6 +443,8 @@ def _direction(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
 
 
 def _beyond(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+    """``beyond X by D [from Z]``: X + D rotated to face away from Z. Scenic 3.1.1 turns Z into a
+    vector before asking whether it is oriented, so the parent orientation is always global (0)."""
     target = E.to_vec(r, ops[0], _op_node(node, 0))
     base = ops[2] if ops[2] is not None else _ego_of(r, node)
     origin = E.to_vec(r, base, _op_node(node, 2))
@@ -450,10 +453,7 @@ def _beyond(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
         offset = Vec(r.f.const(0), offset)
     offset = E.to_vec(r, offset, _op_node(node, 1))
     direction = V.heading_of(r.f, V.sub(r.f, target, origin))
-    values = {
-        "position": V.offset_locally(r.f, target, direction, offset),
-        "parentOrientation": base.get("heading") if E.is_oriented(base) else r.f.const(0),
-    }
+    values = {"position": V.offset_locally(r.f, target, direction, offset), "parentOrientation": r.f.const(0)}
     return Effect("beyond", {"position": 1, "parentOrientation": 3}, lambda view: values, node)
 
 

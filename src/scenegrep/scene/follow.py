@@ -1,0 +1,78 @@
+"""``follow F from X for D`` (and the ``following`` specifier): Scenic's forward Euler walk along a field.
+
+Scenic (``VectorField.followFrom``) takes ``n = max(4, ceil(D / 5))`` equal steps
+of ``D / n`` metres, each along the heading Scenic computes for the field at the
+current point (:meth:`~.geometry.MapGeometry.scenic_headings`: inside an
+intersection, its first connecting lane holding the point). The interval version
+encloses the walk for intervals of start and distance: each step takes the one
+heading a small box's corners agree on, or else every heading the field may
+have in the box.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .geometry import SMALL_BOX_M
+from .terms import Term
+
+if TYPE_CHECKING:
+    from .evaluate import Evaluator
+
+MIN_STEPS = 4
+STEP_M = 5.0
+
+
+def steps_for(distance: np.ndarray) -> np.ndarray:
+    """Scenic's number of Euler steps for each distance."""
+    return np.maximum(MIN_STEPS, np.ceil(np.nan_to_num(distance / STEP_M, nan=0.0))).astype(np.intp)
+
+
+def follow_field(ev: Evaluator, term: Term) -> np.ndarray:
+    """One coordinate (``term.value[1]``: 0 = x, 1 = y) of the walk's end, for every row."""
+    x, y, distance = (np.array(a, dtype=float) for a in ev._args(term))
+    field, axis = term.value
+    steps = steps_for(distance)
+    step = distance / steps
+    for k in range(int(steps.max(initial=0))):
+        active = np.flatnonzero(k < steps)
+        heading = ev.geometry.scenic_headings(field, x[active], y[active], ev.value)
+        x[active] += -np.sin(heading) * step[active]
+        y[active] += np.cos(heading) * step[active]
+    return x if axis == 0 else y
+
+
+def follow_box(geometry, field, x, y, distance, value, covering_arc, intervals):
+    """An enclosure of the walk's end (two intervals) for intervals of start and distance, or None
+    when the field has no heading somewhere along it. Every step takes every heading the field may
+    have in the current box, so the enclosure holds the walk whichever heading Scenic picks."""
+    iv = intervals
+    results = []
+    first = int(max(MIN_STEPS, math.ceil(distance.lo / STEP_M)))
+    last = int(max(MIN_STEPS, math.ceil(distance.hi / STEP_M)))
+    for steps in range(first, last + 1):
+        step = distance / steps
+        px, py = x, y
+        for _ in range(steps):
+            arc = covering_arc(_step_headings(geometry, field, px, py, value))
+            if arc is None:
+                return None
+            px, py = px + (-iv.sin(arc)) * step, py + iv.cos(arc) * step
+        results.append((px, py))
+    return (
+        iv.Interval(min(r[0].lo for r in results), max(r[0].hi for r in results)),
+        iv.Interval(min(r[1].lo for r in results), max(r[1].hi for r in results)),
+    )
+
+
+def _step_headings(geometry, field, px, py, value) -> np.ndarray:
+    """The headings Scenic may take in the box: for a small box those its corners and centre take
+    (the field's cells are convex at that scale), else every heading the field may have there."""
+    if math.hypot(px.width, py.width) / 2 <= SMALL_BOX_M:
+        xs = np.array([px.lo, px.hi, px.lo, px.hi, (px.lo + px.hi) / 2])
+        ys = np.array([py.lo, py.lo, py.hi, py.hi, (py.lo + py.hi) / 2])
+        return np.unique(geometry.scenic_headings(field, xs, ys, lambda t: np.repeat(value(t)[:1], 5)))
+    return np.append(geometry.field_headings_in_box(field, px.lo, px.hi, py.lo, py.hi, value), 0.0)

@@ -211,7 +211,7 @@ def _attribute(r: Resolver, node: ir.Attribute) -> Any:
     if isinstance(value, Namespace):
         if node.attr not in value.attributes:
             raise r.error(f"{value.name} has no attribute {node.attr!r}", node)
-        return value.attributes[node.attr]
+        return r.note_layers(value.attributes[node.attr])
     if isinstance(value, Vec) and node.attr in ("x", "y"):
         return value.x if node.attr == "x" else value.y
     if isinstance(value, Instance):
@@ -283,6 +283,8 @@ def _options(r: Resolver, node: ir.Call, args: list[Any]) -> Any:
             raise r.error("Options weights must be non-negative constants", node)
         values = tuple(v for v, w in zip(values, weights) if w.value > 0)
         values = tuple(evaluate(r, k) for k in values)
+    if isinstance(values, Vec):  # a two-number list
+        values = (values.x, values.y)
     if not isinstance(values, tuple) or not values:
         raise r.error("Options takes a non-empty list or a dict of weights", node)
     return choose(r, node, values)

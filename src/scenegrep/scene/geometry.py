@@ -17,8 +17,11 @@ parameters for the same rows:
   element's own orientation).
 
 Layers a map does not hold (sidewalks, crossings, curbs and shoulders may be
-missing) are reported by :meth:`MapGeometry.missing_layers`; callers decide
-whether that is an error or an unknown.
+missing) are *unknown*: a point or box may lie in them anywhere and nothing is
+proved to lie outside them, so the class defaults that name them (a
+pedestrian's walkable region, a car's road-or-shoulder) constrain nothing on
+such a map. A program that names a missing layer itself is an error
+(:meth:`MapGeometry.missing_layers` lets the caller say so).
 """
 
 from __future__ import annotations
@@ -65,6 +68,7 @@ class MapGeometry:
 
     def __init__(self, road_map: RoadMap | None):
         self.map = road_map
+        self.unknown = self.missing_layers(set(OPTIONAL_LAYERS)) if road_map is not None else set()
 
     # ---------------------------------------------------------------- layers
     def missing_layers(self, layers: set[str]) -> set[str]:
@@ -137,6 +141,8 @@ class MapGeometry:
             return np.ones(n, dtype=bool)
         if isinstance(region, Nowhere):
             return np.zeros(n, dtype=bool)
+        if isinstance(region, MapRegion) and region.layer in self.unknown:
+            return np.ones(n, dtype=bool)
         if isinstance(region, MapRegion):
             boxes = shapely.box(x_lo, y_lo, x_hi, y_hi)
             if region.layer == "curb":
@@ -211,7 +217,9 @@ class MapGeometry:
         return box if box[0] <= box[2] and box[1] <= box[3] else None
 
     def static_geometry(self, region: Region) -> shapely.Geometry | None:
-        """The region as one shapely geometry when it is made of map layers only, else None."""
+        """The region as one shapely geometry when it is made of known map layers only, else None."""
+        if isinstance(region, MapRegion) and region.layer in self.unknown:
+            return None
         if isinstance(region, MapRegion):
             self._require_map()
             return self._unions[region.layer]
@@ -229,7 +237,11 @@ class MapGeometry:
     def contains_boxes(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         """Whether each oriented box lies inside the region (Scenic's ``containsObject``)."""
         n = len(np.atleast_1d(x))
-        if isinstance(region, Everywhere):
+        if (
+            isinstance(region, Everywhere)
+            or self.unknown.intersection(region.layers())
+            and isinstance(region, (MapRegion, Union))
+        ):
             return np.ones(n, dtype=bool)
         if isinstance(region, Nowhere):
             return np.zeros(n, dtype=bool)
@@ -266,6 +278,8 @@ class MapGeometry:
             for part in region.parts:
                 hit |= self.boxes_meet_oriented(part, x, y, heading, length, width, value)
             return hit
+        if isinstance(region, MapRegion) and region.layer in self.unknown:
+            return np.ones(n, dtype=bool)
         if isinstance(region, MapRegion):
             return self._layer_hits(region.layer, _box_polygons(x, y, heading, length, width), "intersects")
         raise UserError(f"testing whether an object meets {_describe(region)} is not supported")

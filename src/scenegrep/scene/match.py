@@ -33,11 +33,13 @@ from .program import ProgramObject, SceneProgram
 
 @dataclass(frozen=True)
 class SceneOptions:
-    """How to match: tolerances, ``exact`` (surjective correspondence), visible distance (m)."""
+    """How to match: tolerances, ``exact`` (surjective correspondence), visible distance (m), and a
+    known (partial) correspondence, program object -> label object id, to check instead of search."""
 
     tolerance: Tolerance = field(default_factory=Tolerance)
     exact: bool = False
     visible_distance: float | None = None
+    correspondence: dict[str, str] | None = None
 
 
 @dataclass
@@ -74,6 +76,10 @@ class Candidates:
             visible = dist <= options.visible_distance
         self.visible = visible
         self.object = states.object
+        self.known = {}
+        if options.correspondence:
+            rows = trace.objects.row_of()
+            self.known = {name: rows.get(label, -1) for name, label in options.correspondence.items()}
 
     def ego_state_per_frame(self, objects: np.ndarray, frames: np.ndarray) -> np.ndarray:
         """The state row of the trace's ego in each frame (-1 where absent)."""
@@ -89,6 +95,8 @@ class Candidates:
             eligible &= np.isin(self.kinds, list(obj.kinds))
         if obj.is_ego and self.ego_row is not None:
             eligible &= self.object == self.ego_row
+        if obj.name in self.known:
+            eligible &= self.object == self.known[obj.name]
         rows = np.flatnonzero(eligible)
         offsets = np.searchsorted(self.frame[rows], np.arange(self.n_frames + 1), side="left")
         return offsets, rows

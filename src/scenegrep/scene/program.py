@@ -84,13 +84,15 @@ class Requirement:
 class SceneProgram:
     """A resolved program: scene objects in creation order, requirements, global parameters
     (name -> defining term; compared with a trace attribute of the same name when present),
-    the ``param map`` path if any, and the term factory that built it all."""
+    the ``param map`` path if any, the map layers the program's own text names, and the term
+    factory that built it all."""
 
     program: ir.Program
     objects: list[ProgramObject] = field(default_factory=list)
     requirements: list[Requirement] = field(default_factory=list)
     params: dict[str, Term] = field(default_factory=dict)
     map_path: str | None = None
+    explicit_layers: set[str] = field(default_factory=set)
     factory: TermFactory = field(default_factory=TermFactory)
 
     def object(self, name: str) -> ProgramObject:

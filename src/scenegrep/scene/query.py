@@ -106,7 +106,14 @@ class SceneQuery:
         options = options or SceneOptions()
         road_map = self._map_for(trace, road_map)
         geometry = MapGeometry(road_map)
-        groups = self._groups_for(geometry, trace)
+        missing = geometry.missing_layers(self.program.explicit_layers) if road_map is not None else set()
+        if missing:
+            names = ", ".join(sorted(missing))
+            raise UserError(
+                f"the program names map layers the road map of trace {trace.name!r} does not have: {names}",
+                at(self.program.program.filename),
+            )
+        groups = self._groups_for(trace)
         matches = match_trace(self.program, groups, trace, geometry, options)
         return SceneResult(trace, self, matches, labels_of(trace), geometry, options)
 
@@ -124,14 +131,10 @@ class SceneQuery:
             at(self.program.program.filename),
         )
 
-    def _groups_for(self, geometry: MapGeometry, trace: LabelTrace) -> list[Group]:
-        """The groups, without Scenic's implicit containment requirements in map layers this map lacks
-        and without parameter checks for attributes the trace does not have."""
+    def _groups_for(self, trace: LabelTrace) -> list[Group]:
+        """The groups, without parameter checks for attributes the trace does not have."""
         dropped = {
-            r
-            for r in self.program.requirements
-            if (r.implicit and geometry.missing_layers(_term_layers(r.condition)))
-            or (r.parameter is not None and r.parameter not in trace.attributes)
+            r for r in self.program.requirements if r.parameter is not None and r.parameter not in trace.attributes
         }
         if not dropped:
             return self.groups

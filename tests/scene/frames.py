@@ -1,0 +1,56 @@
+"""Hand-built labeled frames on the synthetic map of tests/model/maps.py, for scene-query tests.
+
+A frame is a dict ``id -> (class, x, y, heading[, length, width])``; the object named
+``ego`` is the trace's ego. Cars default to 4.5 x 2 m, pedestrians to 0.75 x 0.75 m.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from scenegrep.model import LabelTrace, ObjectTable, StateTable
+from scenegrep.scene import SceneOptions, Tolerance, compile_scene
+from tests.model.maps import synthetic_map
+
+MAP = synthetic_map()
+SIZES = {"Car": (4.5, 2.0), "Pedestrian": (0.75, 0.75), "Truck": (8.0, 2.5), "Cone": (0.4, 0.4)}
+HEADER = "model scenic.domains.driving.model\n"
+
+
+def trace_of(*frames: dict) -> LabelTrace:
+    """A trace with one frame per dict (objects may differ between frames)."""
+    ids = sorted({oid for frame in frames for oid in frame}, key=lambda o: (o != "ego", o))
+    classes = {oid: frame[oid][0] for frame in frames for oid in frame}
+    rows = []
+    for f, frame in enumerate(frames):
+        for oid, spec in sorted(frame.items(), key=lambda item: ids.index(item[0])):
+            category, x, y, heading, *size = spec
+            length, width = size or SIZES[category]
+            rows.append((f, ids.index(oid), x, y, heading, length, width))
+    f, o, x, y, h, length, width = (np.array(column) for column in zip(*rows))
+    states = StateTable.build(f, o, x, y, h, length=length, width=width)
+    objects = ObjectTable.build(ids, [classes[i] for i in ids])
+    n = len(frames)
+    return LabelTrace.build(
+        "hand", np.arange(n), np.arange(n, dtype=float), objects, states, ego="ego" if "ego" in ids else None
+    )
+
+
+def matches(program: str, *frames: dict, **options) -> list[bool]:
+    """Which frames match the program (header added), on the synthetic map."""
+    query = compile_scene(HEADER + program, "test.scenic", options.pop("visible_distance_compile", None))
+    tolerance = Tolerance(options.pop("position", 1e-6), options.pop("heading", 1e-6))
+    result = query.match(trace_of(*frames), MAP, SceneOptions(tolerance, **options))
+    return result.matched.tolist()
+
+
+def ahead(x: float, y: float, heading: float, distance: float) -> tuple[float, float]:
+    """The point ``distance`` metres ahead of (x, y) along a Scenic heading."""
+    return x - distance * math.sin(heading), y + distance * math.cos(heading)
+
+
+def right(x: float, y: float, heading: float, distance: float) -> tuple[float, float]:
+    """The point ``distance`` metres to the right of (x, y) for a Scenic heading."""
+    return x + distance * math.cos(heading), y + distance * math.sin(heading)

@@ -1,0 +1,89 @@
+"""``scenegrep scene``: outputs, options, exit codes, one-line errors."""
+
+from __future__ import annotations
+
+import json
+
+import pyarrow.parquet as pq
+import pytest
+
+from scenegrep.cli.main import main
+from scenegrep.writers.trace_json import write_trace_json
+from scenegrep.writers.trace_parquet import write_map_parquet
+from tests.scene.frames import HEADER, MAP, trace_of
+
+PROGRAM = HEADER + "ego = new Car on road\nother = new Car ahead of ego by Range(4, 10)\n"
+
+
+@pytest.fixture
+def files(tmp_path):
+    """A program, a two-frame trace (frame 0 matches: a car 6 m ahead; frame 1 does not) and a map."""
+    (tmp_path / "ahead.scenic").write_text(PROGRAM)
+    trace = trace_of(
+        {"ego": ("Car", 1.75, 20.0, 0.0), "c": ("Car", 1.75, 30.5, 0.0)},
+        {"ego": ("Car", 1.75, 20.0, 0.0), "c": ("Car", 5.25, 30.5, 0.0)},
+    )
+    write_trace_json(trace, tmp_path / "trace.json")
+    write_map_parquet(MAP, tmp_path / "map.parquet")
+    return tmp_path
+
+
+def run(args, capsys):
+    code = main(["scene", *map(str, args)])
+    out, err = capsys.readouterr()
+    return code, out.splitlines(), err.splitlines()
+
+
+def test_text_output_names_correspondence_and_values(files, capsys):
+    code, lines, err = run([files / "ahead.scenic", files / "trace.json", "--map", files / "map.parquet"], capsys)
+    assert code == 0 and len(lines) == 1
+    assert lines[0].startswith(f"{files / 'trace.json'}:0  ego=ego  other=c  |  ")
+    assert "Range(4, 10)@3:33=6" in lines[0]  # a 6 m gap
+    assert err == ["scenegrep: 1 of 2 frames match"]
+
+
+def test_json_explain_and_parquet(files, capsys):
+    out = files / "matches.parquet"
+    args = [files / "ahead.scenic", files / "trace.json", "--map", files / "map.parquet", "--json", "--explain"]
+    code, lines, _ = run([*args, "--parquet", out], capsys)
+    records = [json.loads(line) for line in lines]
+    assert code == 0 and [r["match"] for r in records] == [True, False]
+    assert records[0]["correspondence"] == {"ego": "ego", "other": "c"}
+    assert records[0]["values"]["Range(4, 10)@3:33"] == pytest.approx(6.0)
+    assert "other.x, other.y" in records[1]["failure"]
+    table = pq.read_table(out).to_pylist()
+    assert [(row["frame"], json.loads(row["correspondence"])["other"]) for row in table] == [(0, "c")]
+
+
+def test_exit_code_options_and_quiet(files, capsys):
+    base = [files / "ahead.scenic", files / "trace.json", "--map", files / "map.parquet"]
+    assert run([*base, "--exact", "-q"], capsys)[:2] == (0, [])
+    code, lines, _ = run([*base, "--tolerance-position", "4"], capsys)
+    assert code == 0 and len(lines) == 2  # frame 1's car is 3.5 m to the side: within 4 m
+    (files / "none.scenic").write_text(HEADER + "ego = new Car on road\nother = new Car behind ego by 3\n")
+    assert run([files / "none.scenic", files / "trace.json", "--map", files / "map.parquet"], capsys)[0] == 1
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("ego = new Car on\n", "scenegrep: error: {p}:2:17: Scenic syntax error"),
+        ("import math\nego = new Car\n", "scenegrep: error: {p}:2:1: imports are not supported"),
+        ("ego = new Car on sidewalk\n", "scenegrep: error: {p}: the program names map layers"),
+    ],
+)
+def test_errors_are_one_line_with_the_place(files, capsys, text, expected):
+    program = files / "bad.scenic"
+    program.write_text(HEADER + text)
+    code, _, err = run([program, files / "trace.json", "--map", files / "map.parquet"], capsys)
+    assert code == 2 and err[0].startswith(expected.format(p=program))
+    assert not any("Traceback" in line for line in err)
+
+
+def test_missing_inputs(files, capsys):
+    code, _, err = run([files / "absent.scenic", files / "trace.json"], capsys)
+    assert code == 2 and err == [f"scenegrep: error: {files / 'absent.scenic'}: no such file"]
+    code, _, err = run([files / "ahead.scenic", files / "trace.json"], capsys)  # no map anywhere
+    assert code == 2 and "has no road map" in err[0]
+    code, _, err = run([files / "ahead.scenic", files / "trace.json", "--tolerance-heading", "-1"], capsys)
+    assert code == 2 and "must not be negative" in err[0]

@@ -149,6 +149,17 @@ def _comparisons(ev: Evaluator, condition: Term) -> list[Linear]:
 
 def _one_unknown(ev: Evaluator, constraints: list[Linear]) -> np.ndarray:
     """Feasibility when at most one scalar unknown appears (vectorised interval intersection)."""
+    ok, low, high, angles = _unknown_interval(ev, constraints)
+    for c, coef in angles:
+        ends = (coef * low + c.form.const, coef * high + c.form.const)
+        lo_v, hi_v = np.minimum(*ends), np.maximum(*ends)
+        ok &= _angle_gap(lo_v, hi_v, (c.lo + c.hi) / 2) <= (c.hi - c.lo) / 2
+    return ok
+
+
+def _unknown_interval(ev: Evaluator, constraints: list[Linear]):
+    """(feasible so far, low, high, heading constraints with their coefficients): the interval of
+    the one unknown that the non-heading constraints allow, per row."""
     n = ev.size
     low, high = np.full(n, -np.inf), np.full(n, np.inf)
     ok = np.ones(n, dtype=bool)
@@ -168,12 +179,7 @@ def _one_unknown(ev: Evaluator, constraints: list[Linear]) -> np.ndarray:
             b = (c.hi - c.form.const) / coef
         low = np.where(fixed, low, np.maximum(low, np.minimum(a, b)))
         high = np.where(fixed, high, np.minimum(high, np.maximum(a, b)))
-    ok &= low <= high
-    for c, coef in angles:
-        ends = (coef * low + c.form.const, coef * high + c.form.const)
-        lo_v, hi_v = np.minimum(*ends), np.maximum(*ends)
-        ok &= _angle_gap(lo_v, hi_v, (c.lo + c.hi) / 2) <= (c.hi - c.lo) / 2
-    return ok
+    return ok & (low <= high), low, high, angles
 
 
 def _angle_gap(lo: np.ndarray, hi: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -187,6 +193,19 @@ def _angle_gap(lo: np.ndarray, hi: np.ndarray, target: np.ndarray) -> np.ndarray
 
 def _pinned_point(ev: Evaluator, constraints: list[Linear], points: set) -> np.ndarray | None:
     """Feasibility when the only unknown is a random point the position features pin down."""
+    pinned = _pinned_box(ev, constraints, points)
+    if pinned is None:
+        return None
+    (x_lo, x_hi), (y_lo, y_hi), rest, region = pinned
+    ok = (x_lo <= x_hi) & (y_lo <= y_hi)
+    for c in rest:
+        ok &= (c.lo <= c.form.const) & (c.form.const <= c.hi)
+    return ok & ev.geometry.boxes_meet(region, x_lo, x_hi, y_lo, y_hi, ev.value)
+
+
+def _pinned_box(ev: Evaluator, constraints: list[Linear], points: set):
+    """((x_lo, x_hi), (y_lo, y_hi), constraints without unknowns, region) when the one random
+    point's coordinates each appear alone with coefficient 1, else None."""
     if len(points) != 1 or len(ev.unknowns) != 2:
         return None
     point = next(iter(points))
@@ -208,14 +227,61 @@ def _pinned_point(ev: Evaluator, constraints: list[Linear], points: set) -> np.n
         box[u] = (lo, hi)
     if set(box) != {px, py}:
         return None
-    region = point.region
-    for term in region.terms():
+    for term in point.region.terms():
         if ev.depends_on_unknowns(term):
             return None
         ev.value(term)
-    (x_lo, x_hi), (y_lo, y_hi) = box[px], box[py]
-    ok = (x_lo <= x_hi) & (y_lo <= y_hi)
-    for c in rest:
-        ok &= (c.lo <= c.form.const) & (c.form.const <= c.hi)
-    ok &= ev.geometry.boxes_meet(region, x_lo, x_hi, y_lo, y_hi, ev.value)
-    return ok
+    return box[px], box[py], rest, point.region
+
+
+def closed_form_witness(ev: Evaluator, group: Group, tolerance: Tolerance, row: int) -> dict[Term, float] | None:
+    """Values of the group's unknowns satisfying row ``row`` when a closed form applies (one unknown
+    in affine constraints, or a pinned point), checked against every constraint; else None."""
+    try:
+        constraints = _linear_constraints(ev, group, tolerance)
+    except NotAffine:
+        return None
+    scalars = {u for c in constraints for u in c.form.coefs}
+    points = {u.value[0] for u in ev.unknowns if u.op == "point"}
+    if not points and len(scalars) == 1:
+        (u,) = scalars
+        ok, low, high, angles = _unknown_interval(ev, constraints)
+        candidates = _candidates(float(low[row]), float(high[row]), angles, row)
+        found = [v for v in candidates if _holds(constraints, row, v)]
+        return {u: found[0]} if ok[row] and found else None
+    pinned = _pinned_box(ev, constraints, points)
+    if pinned is None:
+        return None
+    (x_lo, x_hi), (y_lo, y_hi), _, region = pinned
+    px, py = sorted(ev.unknowns, key=lambda u: u.value[1])
+    x, y = (x_lo[row] + x_hi[row]) / 2, (y_lo[row] + y_hi[row]) / 2
+    inside = ev.geometry.contains_points(region, np.array([x]), np.array([y]), lambda t: ev.value(t)[row : row + 1])
+    return {px: float(x), py: float(y)} if inside[0] else None
+
+
+def _candidates(low: float, high: float, angles: list, row: int) -> list[float]:
+    """Values to try for one unknown: the middle of its interval (or a finite point of it), and for a
+    heading constraint the values in the interval that meet its target exactly."""
+    finite_low, finite_high = max(low, -1e9), min(high, 1e9)
+    values = [(finite_low + finite_high) / 2 if low <= high else low]
+    for c, coef in angles:
+        a, target = float(coef[row]), float((c.lo[row] + c.hi[row]) / 2 - c.form.const[row])
+        if a == 0:
+            continue
+        centre = (finite_low + finite_high) / 2 * a
+        k0 = round((centre - target) / TWO_PI)
+        values += [(target + TWO_PI * k) / a for k in range(k0 - 2, k0 + 3)]
+    return [v for v in values if low <= v <= high]
+
+
+def _holds(constraints: list[Linear], row: int, value: float) -> bool:
+    for c in constraints:
+        coef = next(iter(c.form.coefs.values()), None)
+        v = c.form.const[row] + (0.0 if coef is None else coef[row] * value)
+        if c.angle:
+            middle, half = (c.lo[row] + c.hi[row]) / 2, (c.hi[row] - c.lo[row]) / 2
+            if _angle_gap(np.array([v]), np.array([v]), np.array([middle]))[0] > half:
+                return False
+        elif not c.lo[row] <= v <= c.hi[row]:
+            return False
+    return True

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from .decide import Tolerance, _decide_expanded, decide
+from .decide import Tolerance, _decide_expanded, closed_form_witness, decide
 from .dependencies import Group, _randoms
 from .evaluate import Evaluator, Labels, Rows
 from .geometry import MapGeometry
@@ -59,8 +59,9 @@ def _group_witness(ev: Evaluator, group: Group, tolerance: Tolerance) -> dict[st
     }
     if not ev.unknowns:
         return found
-    outcome = solve(build(ev, group, tolerance, row), ev.geometry, tolerance)
-    assignment = outcome.witness or {}
+    assignment = closed_form_witness(ev, group, tolerance, row)
+    if assignment is None:
+        assignment = solve(build(ev, group, tolerance, row), ev.geometry, tolerance).witness or {}
     points: dict[str, list[float | None]] = {}
     for leaf in ev.unknowns:
         value = assignment.get(leaf)

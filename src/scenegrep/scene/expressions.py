@@ -466,7 +466,8 @@ def _distance_past(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
     base = _from_ego(r, ops[1])
     if not is_oriented(base):
         raise r.error("'distance past X of Y' needs Y an oriented point or object", node)
-    offset = V.sub(r.f, to_vec(r, ops[0], _operand(node, 0)), base.get("position"))
+    # Scenic's OrientedPoint.distancePast: (own position - X) in the own frame, ahead component
+    offset = V.sub(r.f, base.get("position"), to_vec(r, ops[0], _operand(node, 0)))
     return V.rotate(r.f, offset, r.f.op("neg", base.get("heading"))).y
 
 

@@ -87,14 +87,15 @@ class SceneQuery:
     soft: list[Requirement]
 
     def describe_group(self, group: Group) -> str:
-        """The features and requirements of a group, and the program objects it brings in."""
-        parts = []
+        """Why a frame fails at a group: the objects no label object can be, and what fails."""
+        checks = group.describe()
+        if not group.introduces:
+            return f"no correspondence satisfies {checks}"
+        names = []
         for name in group.introduces:
             obj = self.program.object(name)
-            parts.append(f"{name} ({obj.class_name}, line {obj.span.line})")
-        checks = group.describe()
-        where = f" for {', '.join(parts)}" if parts else ""
-        return f"{checks}{where}"
+            names.append(f"{name} ({obj.class_name}, line {obj.span.line})")
+        return f"no labeled object can be {' and '.join(names)}: {checks}"
 
     def uses_map(self) -> bool:
         return bool(_layers(self.program))

@@ -118,12 +118,12 @@ def solve(problem: Problem, geometry: MapGeometry, boxes: dict[Term, tuple[float
     rows, limits = _rows(problem, set(unknowns), memo, index)
     angle_options = [_turns(b, affine(b.term, set(unknowns), memo), boxes) for b in problem.bounds if b.angle]
     angle_bounds = [b for b in problem.bounds if b.angle]
-    pieces = [_triangles(p, geometry, boxes) for p in problem.points]
+    pieces = [triangles(p.region, boxes[p.x], boxes[p.y], geometry) for p in problem.points]
     bounds = [(max(boxes[u][0], -1e9), min(boxes[u][1], 1e9)) for u in unknowns]
     for turns in itertools.product(*angle_options):
         angle_rows, angle_limits = _angle_rows(angle_bounds, turns, memo, index, set(unknowns))
-        for triangles in itertools.product(*pieces):
-            region_rows, region_limits = _triangle_rows(problem, triangles, index)
+        for chosen in itertools.product(*pieces):
+            region_rows, region_limits = _triangle_rows(problem, chosen, index)
             a_ub = np.array(rows + angle_rows + region_rows, dtype=float).reshape(-1, len(unknowns))
             b_ub = np.array(limits + angle_limits + region_limits, dtype=float)
             result = linprog(
@@ -198,18 +198,20 @@ def _angle_rows(
     return rows, limits
 
 
-def _triangles(point, geometry: MapGeometry, boxes: dict[Term, tuple[float, float]]) -> list[np.ndarray]:
-    """Triangles (3 x 2 vertex arrays) covering the point's region inside its box."""
-    region = geometry.static_geometry(point.region)
-    (x0, x1), (y0, y1) = boxes[point.x], boxes[point.y]
+def triangles(region_value, x_range, y_range, geometry: MapGeometry) -> list[np.ndarray]:
+    """Triangles (3 x 2 vertex arrays) covering a map-layer region inside the box x_range x y_range."""
+    region = geometry.static_geometry(region_value)
+    if region is None:
+        raise NotLinear("the region is not made of known map layers")
+    (x0, x1), (y0, y1) = x_range, y_range
     window = shapely.box(max(x0, -1e7), max(y0, -1e7), min(x1, 1e7), min(y1, 1e7))
     part = shapely.intersection(region, window)
     if part.is_empty:
         return []
-    triangles = shapely.get_parts(shapely.constrained_delaunay_triangles(shapely.get_parts(part)))
-    if len(triangles) > MAX_PIECES:
+    parts = shapely.get_parts(shapely.constrained_delaunay_triangles(shapely.get_parts(part)))
+    if len(parts) > MAX_PIECES:
         raise NotLinear("too many pieces")
-    found = [shapely.get_coordinates(t)[:3] for t in triangles if t.area > 0]
+    found = [shapely.get_coordinates(t)[:3] for t in parts if t.area > 0]
     if not found:
         raise NotLinear("the region has no area inside the point's box")
     return found

@@ -19,7 +19,7 @@ from fractions import Fraction
 from ..geometry import MapGeometry
 from ..regions import Intersection, Region, Sector
 from ..terms import Term
-from .linear import NotLinear, _triangles, turns
+from .linear import NotLinear, triangles, turns
 from .problem import Problem
 
 TIMEOUT_MS = 2000
@@ -124,16 +124,14 @@ def _region(encoder: Encoder, region: Region, x, y, point, geometry: MapGeometry
         return z3.And(*(_region(encoder, p, x, y, point, geometry, boxes) for p in region.parts))
     if isinstance(region, Sector):
         return _sector(encoder, region, x, y)
-    if geometry.static_geometry(region) is None:
-        raise NotPolynomial("region")
     try:
-        triangles = _triangles(point, geometry, boxes)
+        pieces = triangles(region, boxes[point.x], boxes[point.y], geometry)
     except NotLinear as error:
         raise NotPolynomial(str(error)) from None
-    if not triangles:
+    if not pieces:
         return z3.BoolVal(False)
     cases = []
-    for (ax, ay), (bx, by), (cx, cy) in triangles:
+    for (ax, ay), (bx, by), (cx, cy) in pieces:
         sign = 1.0 if (bx - ax) * (cy - ay) - (by - ay) * (cx - ax) >= 0 else -1.0
         sides = []
         for (px, py), (qx, qy) in (((ax, ay), (bx, by)), ((bx, by), (cx, cy)), ((cx, cy), (ax, ay))):

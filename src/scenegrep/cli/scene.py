@@ -58,19 +58,22 @@ def _value_text(values: dict[str, Any]) -> str:
     return "  ".join(f"{name}={show(v)}" for name, v in values.items())
 
 
+def _place(trace: Any, source: str, frame: int) -> dict[str, Any]:
+    return {
+        "source": source,
+        "trace": trace.name,
+        "frame": int(trace.frame_index[frame]),
+        "time": float(trace.frame_time[frame]),
+    }
+
+
 def _records(result: Any, source: str, args: argparse.Namespace) -> list[dict[str, Any]]:
     trace = result.trace
     soft = result.soft
     records = []
     for k, frame in enumerate(result.frames().tolist()):
-        record: dict[str, Any] = {
-            "source": source,
-            "trace": trace.name,
-            "frame": int(trace.frame_index[frame]),
-            "time": float(trace.frame_time[frame]),
-            "match": True,
-            "correspondence": result.correspondence(frame),
-        }
+        record: dict[str, Any] = {**_place(trace, source, frame), "match": True}
+        record["correspondence"] = result.correspondence(frame)
         if not args.no_values:
             record["values"] = result.values(frame)
         if soft:
@@ -78,16 +81,7 @@ def _records(result: Any, source: str, args: argparse.Namespace) -> list[dict[st
         records.append(record)
     if args.explain:
         for frame in (~result.matched).nonzero()[0].tolist():
-            records.append(
-                {
-                    "source": source,
-                    "trace": trace.name,
-                    "frame": int(trace.frame_index[frame]),
-                    "time": float(trace.frame_time[frame]),
-                    "match": False,
-                    "failure": result.failure(frame),
-                }
-            )
+            records.append({**_place(trace, source, frame), "match": False, "failure": result.failure(frame)})
         records.sort(key=lambda r: r["time"])
     return records
 

@@ -96,8 +96,8 @@ class Sector(Region):
 
 
 @dataclass(frozen=True)
-class Intersection(Region):
-    """Points in every part."""
+class Combination(Region):
+    """A region made of parts (see :class:`Intersection` and :class:`Union`)."""
 
     parts: tuple[Region, ...]
 
@@ -111,18 +111,13 @@ class Intersection(Region):
 
 
 @dataclass(frozen=True)
-class Union(Region):
+class Intersection(Combination):
+    """Points in every part."""
+
+
+@dataclass(frozen=True)
+class Union(Combination):
     """Points in some part."""
-
-    parts: tuple[Region, ...]
-
-    def terms(self) -> Iterator[Term]:
-        for part in self.parts:
-            yield from part.terms()
-
-    def layers(self) -> Iterator[str]:
-        for part in self.parts:
-            yield from part.layers()
 
 
 @dataclass(frozen=True)

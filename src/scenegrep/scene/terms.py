@@ -139,7 +139,7 @@ def _leaf_dependencies(leaf: Term) -> set[Term]:
     return set()
 
 
-_FOLD: dict[str, Callable[..., Any]] = {
+SCALAR_FUNCTIONS: dict[str, Callable[..., Any]] = {
     "add": lambda a, b: a + b,
     "sub": lambda a, b: a - b,
     "mul": lambda a, b: a * b,
@@ -158,7 +158,11 @@ _FOLD: dict[str, Callable[..., Any]] = {
     "eq": lambda a, b: a == b,
     "ne": lambda a, b: a != b,
     "not": lambda a: not a,
+    "and": lambda a, b: bool(a and b),
+    "or": lambda a, b: bool(a or b),
+    "ite": lambda test, a, b: a if test else b,
 }
+"""Each operation on plain Python values, for folding constants and evaluating at a point."""
 
 
 class TermFactory:
@@ -199,10 +203,10 @@ class TermFactory:
     # ---------------------------------------------------------------- operations
     def op(self, op: str, *args: Term, value: Any = None, kind: str = "num") -> Term:
         """An operation, folded when every operand is constant and the op is a pure function."""
-        if args and all(a.is_const for a in args) and (op in _FOLD and value is None or op == "pow"):
+        if args and all(a.is_const for a in args) and (op in SCALAR_FUNCTIONS and value is None or op == "pow"):
             try:
                 values = [a.value for a in args]
-                return self.const(values[0] ** value if op == "pow" else _FOLD[op](*values))
+                return self.const(values[0] ** value if op == "pow" else SCALAR_FUNCTIONS[op](*values))
             except (ValueError, ZeroDivisionError, OverflowError, TypeError):
                 pass
         simpler = _identity(op, args)

@@ -15,32 +15,8 @@ import numpy as np
 
 from ...model.geometry import normalize_angle
 from ..geometry import MapGeometry
-from ..terms import Term
+from ..terms import SCALAR_FUNCTIONS, Term
 from .problem import Bound, Problem
-
-_SCALAR = {
-    "add": lambda a, b: a + b,
-    "sub": lambda a, b: a - b,
-    "mul": lambda a, b: a * b,
-    "div": lambda a, b: a / b if b != 0 else math.copysign(math.inf, a) if a else math.nan,
-    "neg": lambda a: -a,
-    "abs": abs,
-    "min": min,
-    "max": max,
-    "sin": math.sin,
-    "cos": math.cos,
-    "sqrt": lambda a: math.sqrt(a) if a >= 0 else math.nan,
-    "heading_of": lambda dx, dy: math.atan2(-dx, dy),
-    "wrap": lambda a: float(normalize_angle(a)),
-    "lt": lambda a, b: a < b,
-    "le": lambda a, b: a <= b,
-    "eq": lambda a, b: a == b,
-    "ne": lambda a, b: a != b,
-    "and": lambda a, b: bool(a and b),
-    "or": lambda a, b: bool(a or b),
-    "not": lambda a: not a,
-    "ite": lambda t, a, b: a if t else b,
-}
 
 
 class PointEvaluator:
@@ -70,8 +46,11 @@ class PointEvaluator:
             return self.assignment[term]
         if term.op == "pow":
             return self(term.args[0]) ** term.value
-        if term.op in _SCALAR:
-            return _SCALAR[term.op](*(self(a) for a in term.args))
+        if term.op in SCALAR_FUNCTIONS:
+            try:
+                return SCALAR_FUNCTIONS[term.op](*(self(a) for a in term.args))
+            except (ValueError, ZeroDivisionError, OverflowError):
+                return math.nan
         if term.op == "select":
             return self(term.args[1 + int(self(term.args[0]))])
         return self._geometry(term)

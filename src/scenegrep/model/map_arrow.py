@@ -1,7 +1,7 @@
 """A road map as one Arrow table (scenegrep's Parquet map files and map cache).
 
 One row per map element; ``kind`` is lane, road, intersection, crosswalk,
-sidewalk, curb or drivable. Geometries are WKB (polygons; a curb is a line
+sidewalk, shoulder, curb or drivable. Geometries are WKB (polygons; a curb is a line
 string); lanes also carry their centreline and topology columns.
 """
 
@@ -17,8 +17,8 @@ from .roadmap import Area, Lane, LaneNeighbour, RoadMap
 
 METADATA_KEY = b"scenegrep-map"
 LAYOUT_VERSION = 1
-_AREA_KINDS = ("road", "intersection", "crosswalk", "sidewalk")
-_AREA_FIELDS = ("roads", "intersections", "crosswalks", "sidewalks")
+_AREA_KINDS = ("road", "intersection", "crosswalk", "sidewalk", "shoulder")
+_AREA_FIELDS = ("roads", "intersections", "crosswalks", "sidewalks", "shoulders")
 
 SCHEMA = pa.schema(
     [
@@ -123,6 +123,16 @@ def map_from_table(table: pa.Table) -> RoadMap:
             curbs.append(shapely.get_coordinates(geom))
         elif kind == "drivable":
             drivable = geom
+    road, intersection, crosswalk, sidewalk, shoulder = (tuple(areas[k]) for k in _AREA_KINDS)
     return RoadMap(
-        meta["name"], tuple(lanes), *(tuple(areas[k]) for k in _AREA_KINDS), tuple(curbs), drivable, meta.get("source")
+        meta["name"],
+        tuple(lanes),
+        road,
+        intersection,
+        crosswalk,
+        sidewalk,
+        tuple(curbs),
+        drivable,
+        meta.get("source"),
+        shoulder,
     )

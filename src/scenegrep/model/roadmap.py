@@ -66,7 +66,9 @@ REGION_NAMES = ("lane", "road", "intersection", "crossing", "sidewalk", "drivabl
 
 @dataclass(frozen=True, eq=False)
 class RoadMap:
-    """A road network; see the module docstring. ``curbs`` are polylines (k x 2 arrays)."""
+    """A road network; see the module docstring. ``curbs`` are polylines (k x 2 arrays).
+    ``shoulders`` are the road shoulders where a map separates them from the drivable area
+    (OpenDRIVE); a map whose ``drivable_area`` is given includes its shoulders there."""
 
     name: str
     lanes: tuple[Lane, ...]
@@ -77,6 +79,7 @@ class RoadMap:
     curbs: tuple[np.ndarray, ...] = ()
     drivable_area: BaseGeometry | None = None
     source: str | None = field(default=None, compare=False)
+    shoulders: tuple[Area, ...] = ()
 
     # ------------------------------------------------------------------ lookup tables
     @cached_property
@@ -224,6 +227,7 @@ class RoadMap:
             (self.intersections, other.intersections),
             (self.crosswalks, other.crosswalks),
             (self.sidewalks, other.sidewalks),
+            (self.shoulders, other.shoulders),
         ]
         if any(len(a) != len(b) for a, b in pairs) or len(self.curbs) != len(other.curbs):
             return False
@@ -258,6 +262,7 @@ class RoadMap:
             curbs,
             drivable,
             self.source,
+            near(self.shoulders),
         )
 
 

@@ -21,8 +21,8 @@ Scenic successor plus the connecting lanes of its maneuvers; predecessors are
 the inverse links. A lane's left/right neighbour is that of its first lane
 section having one, with same direction when both sections run the same way.
 Roads, intersections (holding their maneuvers' connecting lanes), crossings,
-sidewalks, the curbs of ordinary roads and the drivable region come over as they
-are in Scenic.
+sidewalks, shoulders, the curbs of ordinary roads and the drivable region come over
+as they are in Scenic.
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ from .common import reading
 from .trace_parquet import read_map as read_cached
 
 FORMAT = "opendrive"
-CONVERSION_VERSION = 2
+CONVERSION_VERSION = 3
 """Bumped whenever the conversion changes, so cached maps are rebuilt."""
 
 
@@ -115,6 +115,7 @@ def convert_network(network: Any, name: str, source: str) -> RoadMap:
         _curbs(network),
         network.drivableRegion.polygons,
         source,
+        _areas(network.shoulders),
     )
 
 

@@ -218,17 +218,19 @@ class Evaluator:
         if op == "region_distance":
             return self.geometry.distances(region, args[0], args[1])
         if op == "box_in_region":
-            x, y, h, length, width = args
-            shrink = 2 * self.position_tolerance
-            return self.geometry.contains_boxes(region, x, y, h, length - shrink, width - shrink, value)
+            x, y, h, length, width, ease = args
+            shrink = 2 * self.position_tolerance * ease
+            return self.geometry.contains_boxes(region, x, y, h, _size(length - shrink), _size(width - shrink), value)
         if op == "box_visible":
-            return self.geometry.boxes_meet_oriented(region, *args, value)
+            x, y, h, length, width, ease = args
+            grow = 2 * self.position_tolerance * ease
+            return self.geometry.boxes_meet_oriented(region, x, y, h, _size(length + grow), _size(width + grow), value)
         if op == "boxes_overlap":
             from .shapes import boxes_overlap
 
-            shrink = 2 * self.position_tolerance
-            a = (*args[:3], args[3] - shrink, args[4] - shrink)
-            b = (*args[5:8], args[8] - shrink, args[9] - shrink)
+            grow = 2 * self.position_tolerance * args[10]
+            a = (*args[:3], _size(args[3] + grow), _size(args[4] + grow))
+            b = (*args[5:8], _size(args[8] + grow), _size(args[9] + grow))
             return boxes_overlap(a, b)
         if op == "follow":
             from .follow import follow_field
@@ -288,6 +290,11 @@ class Evaluator:
                 result = result.plus(part.scaled((index == k).astype(float)))
             return result
         raise NotAffine(f"{op} of an unknown")
+
+
+def _size(size: np.ndarray) -> np.ndarray:
+    """A box side after the tolerance adjustment, never negative."""
+    return np.maximum(size, 0.0)
 
 
 def _value_terms(value: object) -> list[Term]:

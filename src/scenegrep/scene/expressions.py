@@ -179,9 +179,14 @@ def _contains(r: Resolver, node: ir.Compare, thing: Any, region: Any) -> Term:
     """``X in R``: an object's box is inside R (Scenic's containsObject), a point lies in R."""
     area = to_region(r, region, node.right)
     if isinstance(thing, Instance) and thing.is_object:
-        return r.f.op("box_in_region", *box_terms(thing), value=area, kind="bool")
+        return r.f.op("box_in_region", *box_terms(thing), EXACT(r), value=area, kind="bool")
     point = to_vec(r, thing, node.left)
     return r.f.op("in_region", point.x, point.y, value=area, kind="bool")
+
+
+def EXACT(r: Resolver) -> Term:  # noqa: N802 - a constant
+    """The 'ease' argument of a box predicate before :func:`.tolerance.eased` sets it (0: exact)."""
+    return r.f.const(0)
 
 
 def box_terms(obj: Instance) -> tuple[Term, Term, Term, Term, Term]:
@@ -514,7 +519,7 @@ def _can_see(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
 def sees(r: Resolver, sector: Sector, target: Any, node: ir.Node) -> Term:
     """Scenic 2-D visibility without occlusion: an object's box meets the sector, a point lies in it."""
     if isinstance(target, Instance) and target.is_object:
-        return r.f.op("box_visible", *box_terms(target), value=sector, kind="bool")
+        return r.f.op("box_visible", *box_terms(target), EXACT(r), value=sector, kind="bool")
     point = to_vec(r, target, node)
     return r.f.op("in_region", point.x, point.y, value=sector, kind="bool")
 
@@ -522,11 +527,12 @@ def sees(r: Resolver, sector: Sector, target: Any, node: ir.Node) -> Term:
 def _intersects(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
     a, b = ops
     if isinstance(a, Instance) and isinstance(b, Instance) and a.is_object and b.is_object:
-        return r.f.op("boxes_overlap", *box_terms(a), *box_terms(b), kind="bool")
+        return r.f.op("boxes_overlap", *box_terms(a), *box_terms(b), EXACT(r), kind="bool")
     obj, region = (a, b) if isinstance(a, Instance) else (b, a)
     if not (isinstance(obj, Instance) and obj.is_object and isinstance(region, Region)):
         raise r.error("'X intersects Y' needs two objects, or an object and a region", node)
-    return r.f.op("not", r.f.op("box_in_region", *box_terms(obj), value=_complement(region), kind="bool"), kind="bool")
+    inside = r.f.op("box_in_region", *box_terms(obj), EXACT(r), value=_complement(region), kind="bool")
+    return r.f.op("not", inside, kind="bool")
 
 
 def _complement(region: Region) -> Region:

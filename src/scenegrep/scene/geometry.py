@@ -17,10 +17,11 @@ parameters for the same rows:
   element's own orientation).
 
 Layers a map does not hold (sidewalks, crossings, curbs and shoulders may be
-missing) are *unknown*: a point or box may lie in them anywhere and nothing is
-proved to lie outside them, so the class defaults that name them (a
-pedestrian's walkable region, a car's road-or-shoulder) constrain nothing on
-such a map. A program that names a missing layer itself is an error
+missing; a map that gives its drivable area explicitly, as AV2 does, holds its
+shoulders there, so its shoulder layer is known to be empty) are *unknown*: a
+point or box may lie in them anywhere and nothing is proved to lie outside them,
+so the class defaults that name them (a pedestrian's walkable region, a car's
+road-or-shoulder) constrain nothing on such a map. A program that names a missing layer itself is an error
 (:meth:`MapGeometry.missing_layers` lets the caller say so).
 """
 
@@ -79,7 +80,7 @@ class MapGeometry:
             "sidewalk": bool(self.map.sidewalks),
             "crossing": bool(self.map.crosswalks),
             "curb": bool(self.map.curbs),
-            "shoulder": False,
+            "shoulder": bool(self.map.shoulders) or self.map.drivable_area is not None,
         }
         return {layer for layer in layers if not present.get(layer, True)}
 
@@ -100,7 +101,7 @@ class MapGeometry:
             "crossing": [a.polygon for a in road_map.crosswalks],
             "sidewalk": [a.polygon for a in road_map.sidewalks],
             "curb": list(road_map.curb_polylines.geometries),
-            "shoulder": [],
+            "shoulder": [a.polygon for a in road_map.shoulders],
         }
         return {name: np.array([g for g in geoms if not g.is_empty], dtype=object) for name, geoms in parts.items()}
 

@@ -133,14 +133,17 @@ def boxes_in_sectors(x, y, heading, length, width, cx, cy, radius, sector_headin
 
 
 def boxes_overlap(a: tuple, b: tuple) -> np.ndarray:
-    """Whether oriented boxes a[i] and b[i] intersect (touching counts), by separating axes."""
+    """Whether oriented boxes a[i] and b[i] intersect (touching counts), by separating axes: the
+    two boxes' own axes (unit vectors along and across their headings, so degenerate boxes of
+    zero size are points or segments, not special cases)."""
     ca, cb = box_corners(*a), box_corners(*b)
     separated = np.zeros(len(ca), dtype=bool)
-    for corners in (ca, cb):
-        for k in range(2):
-            edge = corners[:, k + 1] - corners[:, k]
-            axis = np.stack([-edge[:, 1], edge[:, 0]], axis=1)
-            pa = np.einsum("ikj,ij->ik", ca, axis)
-            pb = np.einsum("ikj,ij->ik", cb, axis)
+    for heading in (np.atleast_1d(np.asarray(a[2], dtype=float)), np.atleast_1d(np.asarray(b[2], dtype=float))):
+        for axis in (
+            np.stack([-np.sin(heading), np.cos(heading)], axis=1),
+            np.stack([np.cos(heading), np.sin(heading)], axis=1),
+        ):
+            pa = np.einsum("ikj,ij->ik", ca, np.broadcast_to(axis, (len(ca), 2)))
+            pb = np.einsum("ikj,ij->ik", cb, np.broadcast_to(axis, (len(cb), 2)))
             separated |= (pa.max(axis=1) < pb.min(axis=1) - _EPS) | (pb.max(axis=1) < pa.min(axis=1) - _EPS)
     return ~separated

@@ -38,6 +38,7 @@ from .regions import (
     orientation_of,
 )
 from .terms import RandomPoint, RandomVariable, Term
+from .tolerance import eased
 from .values import Delayed, Instance, SelfView, Vec, observed_view, type_name
 
 if TYPE_CHECKING:
@@ -210,7 +211,7 @@ def _add_implicit_requirements(r: Resolver, obj: Instance, modifiers: list[Effec
     box = E.box_terms(obj)
     container = obj.defining.get("regionContainedIn")
     if isinstance(container, Region) and not isinstance(container, Everywhere):
-        term = r.f.op("box_in_region", *box, value=container, kind="bool")
+        term = r.f.op("box_in_region", *box, E.EXACT(r), value=container, kind="bool")
         _implicit(r, term, f"{obj.name} lies inside its regionContainedIn", node)
     require_visible = obj.defining.get("requireVisible")
     if obj.name != "ego" and isinstance(require_visible, Term) and require_visible.value is not False:
@@ -239,7 +240,7 @@ def _add_implicit_requirements(r: Resolver, obj: Instance, modifiers: list[Effec
 
 def _implicit(r: Resolver, term: Term, description: str, where: ir.Node | ir.Span) -> None:
     span = where if isinstance(where, ir.Span) else where.span
-    r.scene.requirements.append(Requirement(term, description, span, implicit=True))
+    r.scene.requirements.append(Requirement(eased(r.f, term), description, span, implicit=True))
 
 
 def add_collision_requirements(r: Resolver) -> None:
@@ -247,7 +248,7 @@ def add_collision_requirements(r: Resolver) -> None:
     objects = [i for i in r.instances if i.is_object]
     for i, a in enumerate(objects):
         for b in objects[i + 1 :]:
-            overlap = r.f.op("boxes_overlap", *E.box_terms(a), *E.box_terms(b), kind="bool")
+            overlap = r.f.op("boxes_overlap", *E.box_terms(a), *E.box_terms(b), E.EXACT(r), kind="bool")
             allowed = r.f.op("or", a.defining["allowCollisions"], b.defining["allowCollisions"], kind="bool")
             term = r.f.op("or", allowed, r.f.op("not", overlap, kind="bool"), kind="bool")
             if not (term.is_const and term.value is True):

@@ -68,11 +68,12 @@ def follow_box(geometry, field, x, y, distance, value, covering_arc, intervals):
     )
 
 
-def _step_headings(geometry, field, px, py, value) -> np.ndarray:
+def _step_headings(geometry, field, px, py, value) -> np.ndarray | None:
     """The headings Scenic may take in the box: for a small box those its corners and centre take
     (the field's cells are convex at that scale), else every heading the field may have there."""
     if math.hypot(px.width, py.width) / 2 <= SMALL_BOX_M:
         xs = np.array([px.lo, px.hi, px.lo, px.hi, (px.lo + px.hi) / 2])
         ys = np.array([py.lo, py.lo, py.hi, py.hi, (py.lo + py.hi) / 2])
         return np.unique(geometry.scenic_headings(field, xs, ys, lambda t: np.repeat(value(t)[:1], 5)))
-    return np.append(geometry.field_headings_in_box(field, px.lo, px.hi, py.lo, py.hi, value), 0.0)
+    headings = geometry.field_headings_in_box(field, px.lo, px.hi, py.lo, py.hi, value)
+    return None if headings is None else np.append(headings, 0.0)

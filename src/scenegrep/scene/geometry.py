@@ -385,8 +385,9 @@ class MapGeometry:
 
     def field_headings_in_box(
         self, field: Field, x0: float, x1: float, y0: float, y1: float, value: Values
-    ) -> np.ndarray:
-        """Every heading the field may take at a point of the box [x0, x1] x [y0, y1] (a superset).
+    ) -> np.ndarray | None:
+        """Every heading the field may take at a point of the box [x0, x1] x [y0, y1] (a superset),
+        or None — any heading — for a box wider than :data:`WIDE_BOX_M` (not worth the lookup).
 
         A point's heading is that of the segment of a polyline (lane centreline or curb) nearest to
         it; for any point of the box that segment lies within d + 2h of the box centre, where d is
@@ -395,6 +396,8 @@ class MapGeometry:
         """
         road_map = self._require_map()
         cx, cy, h = (x0 + x1) / 2, (y0 + y1) / 2, math.hypot(x1 - x0, y1 - y0) / 2
+        if h > WIDE_BOX_M:
+            return None
         if h <= SMALL_BOX_M:
             uniform = self._uniform_headings(field, x0, x1, y0, y1, value)
             if uniform is not None:
@@ -427,6 +430,9 @@ class MapGeometry:
                 headings.append(polylines.heading[segments][distance <= distance.min() + 2 * h + 1e-9])
         return np.concatenate(headings) if headings else np.zeros(0)
 
+
+WIDE_BOX_M = 10.0
+"""Half-diagonal (m) beyond which a box's field headings are not looked up (any heading)."""
 
 SMALL_BOX_M = 0.01
 """Boxes with a half-diagonal up to this (m) whose corners and centre all take the same headings

@@ -210,8 +210,11 @@ def _follow(ev: BoxEvaluator, term: Term, args: list[Interval]) -> Interval | No
     return None if end is None else end[term.value[1]]
 
 
-def covering_arc(headings: np.ndarray) -> Interval | None:
-    """The shortest interval (unwrapped: it may reach past π) holding every heading modulo 2π."""
+def covering_arc(headings: np.ndarray | None) -> Interval | None:
+    """The shortest interval (unwrapped: it may reach past π) holding every heading modulo 2π;
+    the whole circle for None (any heading), None for no heading at all."""
+    if headings is None:
+        return Interval(-math.pi, math.pi)
     if len(headings) == 0:
         return None
     angles = np.sort(np.mod(headings, 2 * math.pi))

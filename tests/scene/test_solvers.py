@@ -9,13 +9,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.scene.decide import Tolerance
-from scenegrep.scene.geometry import MapGeometry
+from scenegrep.scene.geometry import GEOMETRY_CACHE_SIZE, MapGeometry, geometry_of
 from scenegrep.scene.regions import MapField, MapRegion, Sector
 from scenegrep.scene.shapes import points_in_sector
 from scenegrep.scene.solvers import linear, smt, solve
 from scenegrep.scene.solvers.branch_prune import BranchAndPrune, covering_arc
 from scenegrep.scene.solvers.problem import Bound, PointUnknown, Problem
 from scenegrep.scene.terms import RandomPoint, RandomVariable, TermFactory
+from tests.model.maps import synthetic_map
 from tests.scene.frames import MAP
 
 GEOMETRY = MapGeometry(MAP)
@@ -104,3 +105,13 @@ def test_a_point_on_the_curb_is_solved_per_segment():
     assert abs(outcome.witness[x] + 3.5) < 1e-6
     problem.bounds[0] = Bound(left_x, -5.0 - 1e-6, -5.0 + 1e-6)
     assert not solve(problem, GEOMETRY, Tolerance()).feasible
+
+
+def test_the_geometry_of_a_map_is_shared_and_the_cache_is_bounded():
+    assert geometry_of(MAP) is geometry_of(MAP)
+    assert geometry_of(None) is not geometry_of(None)
+    first = geometry_of(MAP)
+    others = [synthetic_map() for _ in range(GEOMETRY_CACHE_SIZE)]
+    assert len({id(geometry_of(m)) for m in others}) == GEOMETRY_CACHE_SIZE
+    assert geometry_of(MAP) is not first  # evicted by the newer maps, rebuilt
+    assert geometry_of(others[-1]).map is others[-1]

@@ -28,6 +28,7 @@ road-or-shoulder) constrain nothing on such a map. A program that names a missin
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from collections.abc import Callable
 from functools import cached_property
 
@@ -60,8 +61,26 @@ Values = Callable[[Term], np.ndarray]
 CURB_REACH_M = 1e-6
 """A point is on a curb when it lies within this distance of a curb polyline."""
 
+GEOMETRY_CACHE_SIZE = 8
+"""How many road maps' geometries :func:`geometry_of` keeps (least recently used dropped)."""
+
 OPTIONAL_LAYERS = ("sidewalk", "crossing", "curb", "shoulder")
 """Layers some maps lack; lanes, the drivable area, roads and intersections are always known."""
+
+
+def geometry_of(road_map: RoadMap | None) -> MapGeometry:
+    """The :class:`MapGeometry` of ``road_map``, shared by every query over the same map object
+    (its layer unions and region geometries are built once, on first use); the last
+    :data:`GEOMETRY_CACHE_SIZE` maps are kept."""
+    if road_map is None:
+        return MapGeometry(None)
+    geometry = _GEOMETRIES.pop(id(road_map), None)
+    if geometry is None:
+        geometry = MapGeometry(road_map)
+    _GEOMETRIES[id(road_map)] = geometry
+    while len(_GEOMETRIES) > GEOMETRY_CACHE_SIZE:
+        _GEOMETRIES.popitem(last=False)
+    return geometry
 
 
 class MapGeometry:
@@ -70,6 +89,7 @@ class MapGeometry:
     def __init__(self, road_map: RoadMap | None):
         self.map = road_map
         self.unknown = self.missing_layers(set(OPTIONAL_LAYERS)) if road_map is not None else set()
+        self._static: dict[Region, shapely.Geometry | None] = {}
 
     # ---------------------------------------------------------------- layers
     def missing_layers(self, layers: set[str]) -> set[str]:
@@ -218,7 +238,16 @@ class MapGeometry:
         return box if box[0] <= box[2] and box[1] <= box[3] else None
 
     def static_geometry(self, region: Region) -> shapely.Geometry | None:
-        """The region as one shapely geometry when it is made of known map layers only, else None."""
+        """The region as one (prepared) shapely geometry when it is made of known map layers only,
+        else None; computed once per region."""
+        if region not in self._static:
+            geometry = self._static_geometry(region)
+            if geometry is not None:
+                shapely.prepare(geometry)
+            self._static[region] = geometry
+        return self._static[region]
+
+    def _static_geometry(self, region: Region) -> shapely.Geometry | None:
         if isinstance(region, MapRegion) and region.layer in self.unknown:
             return None
         if isinstance(region, MapRegion):
@@ -286,13 +315,11 @@ class MapGeometry:
         raise UserError(f"testing whether an object meets {_describe(region)} is not supported")
 
     def _static_union(self, region: Region) -> shapely.Geometry:
-        """The shapely geometry of a region built only from map layers."""
-        if isinstance(region, MapRegion):
-            self._require_map()
-            return self._unions[region.layer]
-        if isinstance(region, Union):
-            return shapely.union_all([self._static_union(p) for p in region.parts])
-        raise UserError(f"containment in {_describe(region)} is not supported")
+        """The shapely geometry of a region built only from known map layers."""
+        geometry = self.static_geometry(region)
+        if geometry is None:
+            raise UserError(f"containment in {_describe(region)} is not supported")
+        return geometry
 
     # ---------------------------------------------------------------- distances and fields
     def distances(self, region: Region, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -478,3 +505,6 @@ def _box_polygons(x, y, heading, length, width) -> np.ndarray:
 
 def _describe(region: Region) -> str:
     return f"a region of kind {type(region).__name__}"
+
+
+_GEOMETRIES: OrderedDict[int, MapGeometry] = OrderedDict()

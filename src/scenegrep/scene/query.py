@@ -23,7 +23,7 @@ from ..errors import UserError, at
 from ..model import LabelTrace, RoadMap
 from ..scenic.adapter import parse_program
 from .dependencies import Group, analyse
-from .geometry import MapGeometry
+from .geometry import MapGeometry, geometry_of
 from .evaluate import Labels
 from .explain import soft_requirements, witness_values
 from .match import SceneOptions, TraceMatches, labels_of, match_trace
@@ -106,7 +106,7 @@ class SceneQuery:
         """Match every frame of ``trace`` (see :mod:`.match`)."""
         options = options or SceneOptions()
         road_map = self._map_for(trace, road_map)
-        geometry = MapGeometry(road_map)
+        geometry = geometry_of(road_map)
         missing = geometry.missing_layers(self.program.explicit_layers) if road_map is not None else set()
         if missing:
             names = ", ".join(sorted(missing))

@@ -125,6 +125,11 @@ class RoadMap:
         return {name: STRtree(np.array(geoms, dtype=object)) for name, geoms in groups.items()}
 
     @cached_property
+    def _prepared_drivable(self) -> BaseGeometry:
+        shapely.prepare(self.drivable)
+        return self.drivable
+
+    @cached_property
     def drivable(self) -> BaseGeometry:
         """The drivable area; the union of the lane polygons when the map gives none."""
         if self.drivable_area is not None:
@@ -201,9 +206,11 @@ class RoadMap:
         """Whether each point lies in the named region (one of :data:`REGION_NAMES`), boundary included."""
         x, y = np.atleast_1d(np.asarray(x, dtype=float)), np.atleast_1d(np.asarray(y, dtype=float))
         inside = np.zeros(len(x), dtype=bool)
-        if region == "lane":
+        if region == "lane" or (region == "drivable" and self.drivable_area is None):
             inside[self.lanes_containing(x, y)[0]] = True
             return inside
+        if region == "drivable":
+            return shapely.intersects_xy(self._prepared_drivable, x, y)
         if region not in self._region_trees:
             raise KeyError(f"unknown map region {region!r}; known: {', '.join(REGION_NAMES)}")
         tree = self._region_trees[region]

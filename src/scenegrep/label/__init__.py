@@ -1,0 +1,12 @@
+"""Behaviour labels derived from tracks and the road map (``scenegrep label``).
+
+Pipeline: :mod:`.tracks` (segments, windows) → :mod:`.evidence` (kinematics and map relations)
+→ :mod:`.rules` (confidences per behaviour, thresholds from :mod:`.config`) → :mod:`.labeller`
+(label sets) → :mod:`.statistics` (per-class summaries).
+"""
+
+from .config import DEFAULT_CONFIG, LabelConfig, load_config
+from .labeller import Labelling, label_trace
+from .rules import REFINEMENTS, VOCABULARY
+
+__all__ = ["DEFAULT_CONFIG", "REFINEMENTS", "VOCABULARY", "LabelConfig", "Labelling", "label_trace", "load_config"]

@@ -1,0 +1,70 @@
+"""Behaviour labels for every object of a trace, from its tracks and the road map.
+
+:func:`label_trace` gathers the evidence (:mod:`.evidence`), scores every behaviour
+(:mod:`.rules`) and keeps as an observation's label set every behaviour whose confidence is at
+least the minimum confidence (seed 000's thresholding of a behaviour predictor); a set is never
+empty: when no behaviour reaches the minimum, the most confident one is kept. The labelled trace
+keeps everything of the input but its behaviour labels (replaced, with their confidences) and
+fills the lane of observations that had none with the map lane the labeller found.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..model import BehaviourLabels, LabelTrace, RoadMap
+from .config import LabelConfig, load_config
+from .evidence import Evidence, gather
+from .rules import VOCABULARY, confidences
+from .tracks import Tracks
+
+
+@dataclass(frozen=True)
+class Labelling:
+    """A labelled trace and, per state row, whether the object is in an intersection."""
+
+    trace: LabelTrace
+    in_intersection: np.ndarray
+    evidence: Evidence
+    tracks: Tracks
+
+
+def label_trace(
+    trace: LabelTrace,
+    road_map: RoadMap | None = None,
+    config: LabelConfig | None = None,
+    min_confidence: float | None = None,
+) -> Labelling:
+    """Label ``trace`` (see the module docstring); ``min_confidence`` overrides the configuration's."""
+    config = config or load_config()
+    threshold = config.labels.min_confidence if min_confidence is None else min_confidence
+    tracks = Tracks.of(trace, config.tracks.max_gap_s)
+    evidence = gather(trace, road_map, tracks, config.tracks.smooth_s)
+    kinds = trace.objects.kinds()[trace.states.object[tracks.order]]
+    scores = confidences(evidence, kinds, tracks, config)
+    member = scores >= max(threshold, np.finfo(float).tiny)
+    best = np.argmax(scores, axis=1)
+    member[np.arange(len(best)), best] |= ~member.any(axis=1)
+    labels = BehaviourLabels(
+        VOCABULARY,
+        tracks.to_rows(member),
+        tracks.to_rows(np.where(member, scores, np.nan).astype(np.float32)),
+    )
+    labelled = replace(trace, behaviours=labels, **_with_lanes(trace, road_map, tracks.to_rows(evidence.lane)))
+    return Labelling(labelled, tracks.to_rows(evidence.in_intersection), evidence, tracks)
+
+
+def _with_lanes(trace: LabelTrace, road_map: RoadMap | None, lane: np.ndarray) -> dict:
+    """The states and lane vocabulary with unknown lanes filled from map lane indices."""
+    fill = (trace.states.lane < 0) & (lane >= 0)
+    if road_map is None or not fill.any():
+        return {}
+    map_ids = [lane.id for lane in road_map.lanes]
+    known = set(trace.lane_ids)
+    lane_ids = trace.lane_ids + tuple(map_ids[i] for i in np.unique(lane[fill]).tolist() if map_ids[i] not in known)
+    code = {name: k for k, name in enumerate(lane_ids)}
+    translate = np.array([code.get(name, -1) for name in map_ids], dtype=trace.states.lane.dtype)
+    codes = np.where(fill, translate[np.maximum(lane, 0)], trace.states.lane)
+    return {"states": replace(trace.states, lane=codes), "lane_ids": lane_ids}

@@ -1,0 +1,143 @@
+"""Confidences of the primitive behaviours from the evidence (:mod:`.evidence`), by kind of object.
+
+Every confidence is a product of ramps (:data:`~.config.Ramp`) over the evidence, in [0, 1]:
+
+* vehicles (cars, trucks, buses, trailers, motorcycles): ``Stationary`` by the speed; moving is
+  its complement. ``LaneChangeLeft``/``Right`` by the speed across the lane (or a lane-id change
+  to the same-direction neighbour within ``lane_change_event_s``, with some lateral speed), while
+  moving and outside intersections, reduced where that side has no same-direction lane; the speed
+  across must also be sustained on average over ``lane_change_event_s`` either side (noise is not).
+  ``FollowLane`` while moving, aligned with the lane, not changing lanes and not reversing.
+  ``TurnLeft``/``Right`` by the heading change over ``turn_window_s`` near an intersection (anywhere
+  on a map without intersections). A lane change is also nearly straight (``lane_change_yaw_rate_radps``). ``Brake`` and
+  ``Accelerate`` by the longitudinal acceleration while moving; ``Reverse`` by the speed along
+  the object's own heading.
+* pedestrians, cyclists and animals: ``Stationary`` by the speed, ``Walk`` its complement,
+  ``Cross`` walking in a crosswalk, or across a lane's direction on it (or anywhere else on the
+  drivable area, reduced).
+* anything else (static objects): ``Stationary`` by the vehicle speed ramp.
+
+A track with no usable speed (a single observation) gets ``[tracks].unknown_confidence`` for
+Stationary and for moving. Refinements of Scenic's generic behaviours are listed in
+:data:`REFINEMENTS`: a program's ``LaneChangeBehavior`` is seen here as LaneChangeLeft or Right.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.geometry import heading_difference
+from ..model.taxonomy import VEHICLE_KINDS
+from .config import LabelConfig, PedestrianConfig, Ramp, VehicleConfig
+from .evidence import Evidence
+from .tracks import Tracks
+
+VEHICLE_BEHAVIOURS = (
+    "Stationary",
+    "FollowLane",
+    "LaneChangeLeft",
+    "LaneChangeRight",
+    "TurnLeft",
+    "TurnRight",
+    "Brake",
+    "Accelerate",
+    "Reverse",
+)
+PEDESTRIAN_BEHAVIOURS = ("Stationary", "Walk", "Cross")
+VOCABULARY = tuple(dict.fromkeys(VEHICLE_BEHAVIOURS + PEDESTRIAN_BEHAVIOURS))
+"""Every behaviour the labeller emits, in column order."""
+
+WALKING_KINDS = frozenset({"pedestrian", "bicycle", "animal"})
+"""Kinds labelled with :data:`PEDESTRIAN_BEHAVIOURS`."""
+
+REFINEMENTS = {"LaneChange": ("LaneChangeLeft", "LaneChangeRight"), "Turn": ("TurnLeft", "TurnRight")}
+"""Scenic's generic primitive behaviours and the labels that refine them."""
+
+
+def ramp(values: np.ndarray, bounds: Ramp) -> np.ndarray:
+    """0 at ``bounds[0]``, 1 at ``bounds[1]``, linear between, clipped; NaN stays NaN."""
+    low, high = bounds
+    return np.clip((values - low) / (high - low), 0.0, 1.0)
+
+
+def confidences(evidence: Evidence, kinds: np.ndarray, tracks: Tracks, config: LabelConfig) -> np.ndarray:
+    """(observations, len(VOCABULARY)) confidences in track order; ``kinds`` per observation."""
+    out = np.zeros((len(kinds), len(VOCABULARY)))
+    column = {name: k for k, name in enumerate(VOCABULARY)}
+    vehicle = np.isin(kinds, list(VEHICLE_KINDS))
+    walking = np.isin(kinds, list(WALKING_KINDS))
+    unknown = config.tracks.unknown_confidence
+    for name, score in _vehicle(evidence, tracks, config.vehicle, unknown).items():
+        out[vehicle, column[name]] = score[vehicle]
+    for name, score in _walking(evidence, config.pedestrian, unknown).items():
+        out[walking, column[name]] = score[walking]
+    other = ~(vehicle | walking)
+    out[other, column["Stationary"]] = _stationary(evidence.speed, config.vehicle.stationary_speed_mps, unknown)[other]
+    return out
+
+
+def _stationary(speed: np.ndarray, bounds: Ramp, unknown: float) -> np.ndarray:
+    return np.nan_to_num(ramp(speed, bounds), nan=unknown)
+
+
+def _vehicle(e: Evidence, tracks: Tracks, c: VehicleConfig, unknown: float) -> dict[str, np.ndarray]:
+    stationary = _stationary(e.speed, c.stationary_speed_mps, unknown)
+    moving = np.where(np.isnan(e.speed), unknown, 1.0 - stationary)
+    left, right = _lane_changes(e, tracks, c, moving)
+    reverse = np.nan_to_num(ramp(e.along, c.reverse_speed_mps))
+    misalignment = np.abs(heading_difference(e.heading, e.lane_heading))
+    aligned = np.where(e.lane >= 0, np.nan_to_num(ramp(misalignment, c.follow_heading_rad)), c.off_lane_follow)
+    turn = _turn_angle(e, tracks, c)
+    return {
+        "Stationary": stationary,
+        "FollowLane": moving * aligned * (1.0 - np.maximum(left, right)) * (1.0 - reverse),
+        "LaneChangeLeft": left,
+        "LaneChangeRight": right,
+        "TurnLeft": np.nan_to_num(ramp(turn, c.turn_heading_change_rad)),
+        "TurnRight": np.nan_to_num(ramp(-turn, c.turn_heading_change_rad)),
+        "Brake": moving * np.nan_to_num(ramp(e.accel, c.brake_accel_mps2)),
+        "Accelerate": moving * np.nan_to_num(ramp(e.accel, c.accelerate_accel_mps2)),
+        "Reverse": reverse,
+    }
+
+
+def _lane_changes(e: Evidence, tracks: Tracks, c: VehicleConfig, moving: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Confidences of a change to the left and to the right lane."""
+    half = max(1, tracks.frames(c.lane_change_event_s))
+    straight = np.nan_to_num(ramp(np.abs(e.yaw_rate), c.lane_change_yaw_rate_radps), nan=1.0)
+    allowed = moving * ~e.in_intersection * straight
+    sides = []
+    sustained = tracks.window_mean(e.lateral, half)
+    for sign, change, has_lane in ((1.0, e.change_left, e.has_left), (-1.0, e.change_right, e.has_right)):
+        lateral = sign * e.lateral
+        near_change = tracks.window_any(change, half)
+        moving_across = np.nan_to_num(
+            ramp(lateral, c.lane_change_lateral_mps) * ramp(sign * sustained, c.lane_change_sustained_mps)
+        )
+        evidence = np.maximum(
+            moving_across, near_change * np.nan_to_num(ramp(lateral, c.lane_change_event_lateral_mps))
+        )
+        sides.append(evidence * allowed * np.where(has_lane | near_change, 1.0, c.no_neighbour_factor))
+    return sides[0], sides[1]
+
+
+def _turn_angle(e: Evidence, tracks: Tracks, c: VehicleConfig) -> np.ndarray:
+    """Signed heading change (radians, left positive) over a centred window of ``turn_window_s``,
+    zero farther than ``turn_intersection_margin_s`` from any intersection on a map that has some."""
+    half = max(1, tracks.frames(c.turn_window_s) // 2)
+    position = np.arange(len(tracks))
+    later = np.minimum(position + half, tracks.end - 1)
+    earlier = np.maximum(position - half, tracks.start)
+    change = e.heading[later] - e.heading[earlier]
+    if not e.knows_intersections:
+        return change
+    near = tracks.window_any(e.in_intersection, max(1, tracks.frames(c.turn_intersection_margin_s)))
+    return np.where(near, change, 0.0)
+
+
+def _walking(e: Evidence, c: PedestrianConfig, unknown: float) -> dict[str, np.ndarray]:
+    stationary = _stationary(e.speed, c.stationary_speed_mps, unknown)
+    walk = np.where(np.isnan(e.speed), unknown, 1.0 - stationary)
+    across = np.arcsin(np.abs(np.sin(heading_difference(e.motion_heading, e.lane_heading))))
+    on_road = np.where(e.lane >= 0, np.nan_to_num(ramp(across, c.cross_angle_rad)), e.on_drivable * c.off_lane_cross)
+    return {"Stationary": stationary, "Walk": walk, "Cross": walk * np.maximum(e.in_crossing, on_road)}

@@ -53,7 +53,7 @@ def test_unknown_and_missing_inputs(tmp_path):
         readers.detect_format(tmp_path / "notes.txt")
     with pytest.raises(UserError, match="no such file"):
         readers.detect_format(tmp_path / "absent.json")
-    with pytest.raises(UserError, match="not an Argoverse 2 log"):
+    with pytest.raises(UserError, match="neither an Argoverse 2 log or scenario nor holds trace files"):
         readers.detect_format(tmp_path)
 
 

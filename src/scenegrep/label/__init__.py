@@ -7,6 +7,6 @@ Pipeline: :mod:`.tracks` (segments, windows) → :mod:`.evidence` (kinematics an
 
 from .config import DEFAULT_CONFIG, LabelConfig, load_config
 from .labeller import Labelling, label_trace
-from .rules import REFINEMENTS, VOCABULARY
+from .rules import SCENIC_LABELS, VOCABULARY
 
-__all__ = ["DEFAULT_CONFIG", "REFINEMENTS", "VOCABULARY", "LabelConfig", "Labelling", "label_trace", "load_config"]
+__all__ = ["DEFAULT_CONFIG", "SCENIC_LABELS", "VOCABULARY", "LabelConfig", "Labelling", "label_trace", "load_config"]

@@ -6,10 +6,11 @@ Every confidence is a product of ramps (:data:`~.config.Ramp`) over the evidence
   its complement. ``LaneChangeLeft``/``Right`` by the speed across the lane (or a lane-id change
   to the same-direction neighbour within ``lane_change_event_s``, with some lateral speed), while
   moving and outside intersections, reduced where that side has no same-direction lane; the speed
-  across must also be sustained on average over ``lane_change_event_s`` either side (noise is not).
+  across must also be sustained on average over ``lane_change_event_s`` either side (noise is not)
+  and, unless the lane id changes nearby, the path nearly straight (curves read as lateral motion).
   ``FollowLane`` while moving, aligned with the lane, not changing lanes and not reversing.
   ``TurnLeft``/``Right`` by the heading change over ``turn_window_s`` near an intersection (anywhere
-  on a map without intersections). A lane change is also nearly straight (``lane_change_yaw_rate_radps``). ``Brake`` and
+  on a map without intersections). ``Brake`` and
   ``Accelerate`` by the longitudinal acceleration while moving; ``Reverse`` by the speed along
   the object's own heading.
 * pedestrians, cyclists and animals: ``Stationary`` by the speed, ``Walk`` its complement,
@@ -18,8 +19,8 @@ Every confidence is a product of ramps (:data:`~.config.Ramp`) over the evidence
 * anything else (static objects): ``Stationary`` by the vehicle speed ramp.
 
 A track with no usable speed (a single observation) gets ``[tracks].unknown_confidence`` for
-Stationary and for moving. Refinements of Scenic's generic behaviours are listed in
-:data:`REFINEMENTS`: a program's ``LaneChangeBehavior`` is seen here as LaneChangeLeft or Right.
+Stationary and for moving. :data:`SCENIC_LABELS` says which labels stand for Scenic's library
+behaviours: a program's ``LaneChangeBehavior`` is seen here as LaneChangeLeft or Right.
 """
 
 from __future__ import annotations
@@ -50,8 +51,16 @@ VOCABULARY = tuple(dict.fromkeys(VEHICLE_BEHAVIOURS + PEDESTRIAN_BEHAVIOURS))
 WALKING_KINDS = frozenset({"pedestrian", "bicycle", "animal"})
 """Kinds labelled with :data:`PEDESTRIAN_BEHAVIOURS`."""
 
-REFINEMENTS = {"LaneChange": ("LaneChangeLeft", "LaneChangeRight"), "Turn": ("TurnLeft", "TurnRight")}
-"""Scenic's generic primitive behaviours and the labels that refine them."""
+SCENIC_LABELS = {
+    "LaneChange": ("LaneChangeLeft", "LaneChangeRight"),
+    "Turn": ("TurnLeft", "TurnRight"),
+    "FollowTrajectory": ("FollowLane", "TurnLeft", "TurnRight"),
+    "WalkForward": ("Walk",),
+    "Crossing": ("Cross",),
+}
+"""Primitive behaviours of Scenic's driving library (name without ``Behavior``) and the labels
+that stand for them here (a lane change is seen with its side; following a trajectory of lanes
+is following them, turning where they turn). Other names stand for themselves."""
 
 
 def ramp(values: np.ndarray, bounds: Ramp) -> np.ndarray:
@@ -105,17 +114,16 @@ def _lane_changes(e: Evidence, tracks: Tracks, c: VehicleConfig, moving: np.ndar
     """Confidences of a change to the left and to the right lane."""
     half = max(1, tracks.frames(c.lane_change_event_s))
     straight = np.nan_to_num(ramp(np.abs(e.yaw_rate), c.lane_change_yaw_rate_radps), nan=1.0)
-    allowed = moving * ~e.in_intersection * straight
-    sides = []
+    allowed = moving * ~e.in_intersection
     sustained = tracks.window_mean(e.lateral, half)
+    sides = []
     for sign, change, has_lane in ((1.0, e.change_left, e.has_left), (-1.0, e.change_right, e.has_right)):
         lateral = sign * e.lateral
         near_change = tracks.window_any(change, half)
-        moving_across = np.nan_to_num(
-            ramp(lateral, c.lane_change_lateral_mps) * ramp(sign * sustained, c.lane_change_sustained_mps)
-        )
+        moving_across = ramp(lateral, c.lane_change_lateral_mps) * ramp(sign * sustained, c.lane_change_sustained_mps)
         evidence = np.maximum(
-            moving_across, near_change * np.nan_to_num(ramp(lateral, c.lane_change_event_lateral_mps))
+            np.nan_to_num(moving_across) * straight,
+            near_change * np.nan_to_num(ramp(lateral, c.lane_change_event_lateral_mps)),
         )
         sides.append(evidence * allowed * np.where(has_lane | near_change, 1.0, c.no_neighbour_factor))
     return sides[0], sides[1]

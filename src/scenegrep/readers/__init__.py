@@ -67,6 +67,9 @@ FORMATS: dict[str, Format] = {
         Format("waymo-tfrecord", "waymo_tfrecord", "Waymo Open Motion Scenario TFRecord", True, True, many=True),
         Format("commonroad", "commonroad", "CommonRoad 2018b/2020a scenario XML", True, True),
         Format("opendrive", "opendrive", "OpenDRIVE road network (.xodr) through Scenic", False, True),
+        Format(
+            "trace-folder", "trace_folder", "folder of trace files (each read in name order)", True, False, many=True
+        ),
     )
 }
 
@@ -88,7 +91,8 @@ def _sniff_json(path: Path) -> str | None:
     return None
 
 
-def _sniff_file(path: Path) -> str | None:
+def sniff_file(path: Path) -> str | None:
+    """The format of a file from its name and first bytes, or None."""
     suffix = path.suffix.lower()
     if suffix == ".json":
         return _sniff_json(path)
@@ -117,10 +121,12 @@ def detect_format(path: str | Path) -> str:
             return "av2-sensor"
         if any(path.glob("scenario_*.parquet")):
             return "av2-forecasting"
-        raise UserError("a directory that is not an Argoverse 2 log or scenario", at(path))
+        if module("trace-folder").trace_files(path):
+            return "trace-folder"
+        raise UserError("a directory that is neither an Argoverse 2 log or scenario nor holds trace files", at(path))
     if not path.exists():
         raise UserError("no such file or directory", at(path))
-    found = _sniff_file(path)
+    found = sniff_file(path)
     if found is None:
         raise UserError(f"unrecognised input format; supported: {', '.join(FORMATS)}", at(path))
     return found

@@ -13,9 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import statistics
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +21,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from timing import median_seconds  # noqa: E402
 from scenegrep import readers  # noqa: E402
 from scenegrep.label import label_trace  # noqa: E402
 from scenegrep.model import LabelTrace, ObjectTable, StateTable  # noqa: E402
@@ -30,16 +29,6 @@ from tests.readers.real_inputs import REAL_TRACES  # noqa: E402
 
 SHARED = REPO.parent / "shared"
 SCENE = SHARED / "real_data" / "nuscenes_mini_scenarionet" / "sd_nuscenes_v1.0-mini_scene-0061.pkl"
-
-
-def median_seconds(call, repeat: int) -> float:
-    call()
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        call()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 def replicated(trace: LabelTrace, k: int) -> LabelTrace:

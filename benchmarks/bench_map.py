@@ -12,11 +12,8 @@ timed on Town06 for comparison.
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
-import time
 import warnings
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +21,7 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from timing import median_seconds  # noqa: E402
 from scenegrep import readers  # noqa: E402
 from scenegrep.model import RoadMap  # noqa: E402
 
@@ -34,16 +32,6 @@ MAPS = [
     "log_map_archive_7fab2350-7eaf-3b7e-a39d-6937a4c1bede____PIT_city_47896.json",
     SHARED / "real_data/nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl",
 ]
-
-
-def median_seconds(call: Callable[[], object], repeat: int) -> float:
-    call()
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        call()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 def per_point_us(road_map: RoadMap, x: np.ndarray, y: np.ndarray, repeat: int) -> dict[str, tuple[float, float]]:

@@ -101,3 +101,13 @@ def test_select_unknown_object_raises():
 def test_behaviour_threshold_keeps_unscored_labels():
     labels = BehaviourLabels.from_sets([{"F": 0.9, "L": 0.2}, {"S": None}])
     assert labels.thresholded(0.5).sets() == [{"F"}, {"S"}]
+
+
+def test_select_frames_keeps_every_object():
+    from tests.label.tracks import trace_of
+
+    x = np.full(4, 1.75)
+    trace = trace_of(("car", x, np.arange(4.0), None), ("car", x[:2] + 3.5, np.arange(2.0), None))
+    kept = trace.select_frames(np.array([False, False, True, True]))
+    assert kept.n_frames == 2 and kept.n_objects == 2 and len(kept.states) == 2
+    assert kept.frame_time.tolist() == trace.frame_time[2:].tolist()

@@ -167,6 +167,10 @@ class LabelTrace:
         keep = (self.frame_time >= t_start) & (self.frame_time <= t_end)
         return self._restrict(keep, np.ones(self.n_objects, dtype=bool))
 
+    def select_frames(self, keep: np.ndarray) -> LabelTrace:
+        """Only the frames where the boolean array ``keep`` (one per frame) is True; every object kept."""
+        return self._restrict(np.asarray(keep, dtype=bool), np.ones(self.n_objects, dtype=bool), drop_unobserved=False)
+
     def select_objects(self, object_ids: list[str] | tuple[str, ...]) -> LabelTrace:
         """Only the given objects (all frames kept); KeyError for an unknown id."""
         rows = self.objects.row_of()

@@ -65,7 +65,7 @@ def add_noise(trace: LabelTrace, noise: LabelNoise, stream: int = 0) -> LabelTra
     """The trace with noise added (see the module docstring); ``trace`` is not changed. The
     result's attributes say ``noise`` (the parameters) and ``noise_stream``."""
     drop, jitter, confuse = (np.random.default_rng([noise.seed, stream, k]) for k in range(3))
-    kept = _drop_frames(trace, drop.random(trace.n_frames) >= noise.drop_frames)
+    kept = trace.select_frames(drop.random(trace.n_frames) >= noise.drop_frames)
     s = kept.states
     n = len(s)
     states = replace(
@@ -79,22 +79,6 @@ def add_noise(trace: LabelTrace, noise: LabelNoise, stream: int = 0) -> LabelTra
         behaviours = _confused(behaviours, confuse.random(n) < noise.confuse_behaviours, confuse.random(n), noise)
     attributes = {**kept.attributes, "noise": noise.as_dict(), "noise_stream": stream}
     return replace(kept, states=states, behaviours=behaviours, attributes=attributes)
-
-
-def _drop_frames(trace: LabelTrace, keep: np.ndarray) -> LabelTrace:
-    """The trace restricted to the frames where ``keep`` is True (objects all kept)."""
-    rows = keep[trace.states.frame]
-    new_position = np.cumsum(keep) - 1
-    states = trace.states.take(rows)
-    states = replace(states, frame=new_position[states.frame].astype(states.frame.dtype))
-    behaviours = None if trace.behaviours is None else trace.behaviours.take(rows)
-    return replace(
-        trace,
-        frame_index=trace.frame_index[keep],
-        frame_time=trace.frame_time[keep],
-        states=states,
-        behaviours=behaviours,
-    )
 
 
 def _confused(labels: BehaviourLabels, chosen: np.ndarray, draw: np.ndarray, noise: LabelNoise) -> BehaviourLabels:

@@ -73,3 +73,14 @@ def test_crop_keeps_only_nearby_elements():
 def test_map_table_round_trip():
     assert map_from_table(map_to_table(ROAD_MAP)).equals(ROAD_MAP)
     assert not map_from_table(map_to_table(ROAD_MAP.crop(0, 0, 5))).equals(ROAD_MAP)
+
+
+def test_point_queries_reuse_the_lane_pairs_they_are_given():
+    road_map = synthetic_map()
+    rng = np.random.default_rng(3)
+    x, y, heading = rng.uniform(-5, 9, 300), rng.uniform(-5, 110, 300), rng.uniform(-3, 3, 300)
+    pairs = road_map.lanes_containing(x, y)
+    assert np.array_equal(road_map.lane_at(x, y, heading, pairs=pairs), road_map.lane_at(x, y, heading))
+    assert np.array_equal(road_map.in_intersection(x, y, pairs=pairs), road_map.in_intersection(x, y))
+    for region in ("lane", "drivable"):
+        assert np.array_equal(road_map.contains(region, x, y, pairs=pairs), road_map.contains(region, x, y))

@@ -116,13 +116,14 @@ class _MapRelations:
             none = np.full(n, -1, dtype=np.intp)
             false = np.zeros(n, dtype=bool)
             return cls(none, np.full(n, np.nan), false, false, false, np.zeros(0, np.intp), np.zeros(0, np.intp))
-        lane = road_map.lane_at(x, y, heading)
+        pairs = road_map.lanes_containing(x, y)
+        lane = road_map.lane_at(x, y, heading, pairs=pairs)
         crossing = road_map.contains("crossing", x, y) if road_map.crosswalks else np.zeros(n, dtype=bool)
         return cls(
             lane=lane,
             lane_heading=road_map.lane_direction_at(x, y, lane),
-            in_intersection=road_map.in_intersection(x, y),
-            on_drivable=road_map.contains("drivable", x, y),
+            in_intersection=road_map.in_intersection(x, y, pairs=pairs),
+            on_drivable=road_map.contains("drivable", x, y, pairs=pairs),
             in_crossing=crossing,
             left=_neighbours(road_map, "left"),
             right=_neighbours(road_map, "right"),

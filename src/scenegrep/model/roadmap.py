@@ -156,16 +156,24 @@ class RoadMap:
         order = np.lexsort((lane_idx, point_idx))
         return point_idx[order], lane_idx[order]
 
-    def lane_at(self, x: np.ndarray, y: np.ndarray, heading: np.ndarray | None = None) -> np.ndarray:
+    def lane_at(
+        self,
+        x: np.ndarray,
+        y: np.ndarray,
+        heading: np.ndarray | None = None,
+        *,
+        pairs: tuple[np.ndarray, np.ndarray] | None = None,
+    ) -> np.ndarray:
         """Index of the lane each point is in (-1 for none).
 
         Where lanes overlap (intersections), the lane whose direction at the point is
         closest to ``heading`` (radians) wins when a heading is given, else the lane
-        whose centreline is nearest.
+        whose centreline is nearest. ``pairs`` is :meth:`lanes_containing` of the same
+        points when the caller has it already (here and in the other point queries).
         """
         x, y = np.atleast_1d(np.asarray(x, dtype=float)), np.atleast_1d(np.asarray(y, dtype=float))
         result = np.full(len(x), -1, dtype=np.intp)
-        point_idx, lane_idx = self.lanes_containing(x, y)
+        point_idx, lane_idx = self.lanes_containing(x, y) if pairs is None else pairs
         if len(point_idx) == 0:
             return result
         if heading is None:
@@ -195,19 +203,23 @@ class RoadMap:
         _, lanes = self.lanes_containing(np.array([x]), np.array([y]))
         return self._directions(lanes, np.full(len(lanes), x), np.full(len(lanes), y)).tolist()
 
-    def in_intersection(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def in_intersection(
+        self, x: np.ndarray, y: np.ndarray, *, pairs: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> np.ndarray:
         """Whether each point lies in an intersection area or in an intersection lane."""
         inside = self.contains("intersection", x, y)
-        point_idx, lane_idx = self.lanes_containing(x, y)
+        point_idx, lane_idx = self.lanes_containing(x, y) if pairs is None else pairs
         inside[point_idx[self.lane_is_intersection[lane_idx]]] = True
         return inside
 
-    def contains(self, region: str, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def contains(
+        self, region: str, x: np.ndarray, y: np.ndarray, *, pairs: tuple[np.ndarray, np.ndarray] | None = None
+    ) -> np.ndarray:
         """Whether each point lies in the named region (one of :data:`REGION_NAMES`), boundary included."""
         x, y = np.atleast_1d(np.asarray(x, dtype=float)), np.atleast_1d(np.asarray(y, dtype=float))
         inside = np.zeros(len(x), dtype=bool)
         if region == "lane" or (region == "drivable" and self.drivable_area is None):
-            inside[self.lanes_containing(x, y)[0]] = True
+            inside[(self.lanes_containing(x, y) if pairs is None else pairs)[0]] = True
             return inside
         if region == "drivable":
             return shapely.intersects_xy(self._prepared_drivable, x, y)

@@ -16,16 +16,15 @@ import json
 import statistics
 import sys
 import tempfile
-import time
 from functools import partial
 from pathlib import Path
-from collections.abc import Callable
 
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from timing import repeated_seconds  # noqa: E402
 from scenegrep import readers  # noqa: E402
 from scenegrep.readers.trace_parquet import read_trace as read_parquet  # noqa: E402
 from scenegrep.writers import write_trace_parquet  # noqa: E402
@@ -77,17 +76,6 @@ def synthetic_strem(path: Path, n_frames: int, seed: int = 0) -> Path:
     return path
 
 
-def timed(read: Callable[[], object], repeat: int) -> list[float]:
-    """Seconds of each of ``repeat`` calls, after one warm-up call."""
-    read()
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        read()
-        times.append(time.perf_counter() - start)
-    return times
-
-
 def row(label: str, fmt: str, frames: int, times: list[float]) -> dict:
     median = statistics.median(times)
     return {
@@ -119,7 +107,7 @@ def main() -> None:
                     path.name,
                     fmt,
                     frames,
-                    timed(partial(lambda p, f: list(readers.read_traces(p, f)), path, fmt), args.repeat),
+                    repeated_seconds(partial(lambda p, f: list(readers.read_traces(p, f)), path, fmt), args.repeat),
                 )
             )
             parquet = write_trace_parquet(traces[0], tmp_dir / f"{k}.parquet")
@@ -128,7 +116,7 @@ def main() -> None:
                     path.name,
                     "scenegrep-parquet",
                     traces[0].n_frames,
-                    timed(partial(read_parquet, parquet), args.repeat),
+                    repeated_seconds(partial(read_parquet, parquet), args.repeat),
                 )
             )
         maps = [(SHARED / "maps" / "Town01.xodr", "opendrive"), (SHARED / "maps" / "Town06.xodr", "opendrive")]
@@ -143,7 +131,9 @@ def main() -> None:
                 return readers.read_map(source)
 
             road_map = load()
-            rows.append({**row(path.name, f"map ({fmt})", 0, timed(load, args.repeat)), "lanes": len(road_map.lanes)})
+            rows.append(
+                {**row(path.name, f"map ({fmt})", 0, repeated_seconds(load, args.repeat)), "lanes": len(road_map.lanes)}
+            )
     print(f"{'input':58s} {'format':24s} {'frames':>7s} {'median ms':>10s} {'min..max ms':>16s} {'frames/s':>10s}")
     for r in rows:
         fps = f"{r['frames_per_s']:10.0f}" if r["frames"] else f"{'-':>10s}"

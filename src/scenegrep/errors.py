@@ -60,3 +60,10 @@ def caret(line: str, column: int, width: int = 1) -> str:
     """A two-line display: the source ``line`` and carets under 1-based columns [column, column + width)."""
     width = max(1, min(width, len(line) - column + 1))
     return f"  {line}\n  {' ' * (column - 1)}{'^' * width}"
+
+
+def first_line(exc: BaseException) -> str:
+    """The first line of an exception's message (its type name when it has none), for the
+    one-line report of a library's error."""
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__

@@ -28,15 +28,6 @@ require (distance to other) < 1
 
 
 @pytest.fixture(scope="module")
-def cache(tmp_path_factory):
-    """One user cache for the module, so Town01 is parsed once (by Scenic and by our reader)."""
-    folder = tmp_path_factory.mktemp("cache")
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("SCENEGREP_CACHE", str(folder))
-        yield folder
-
-
-@pytest.fixture(scope="module")
 def ahead(tmp_path_factory):
     path = tmp_path_factory.mktemp("programs") / "ahead.scenic"
     path.write_text(AHEAD)
@@ -49,7 +40,7 @@ def town01(maps_dir):
 
 
 @pytest.fixture(scope="module")
-def trace(ahead, town01, cache):
+def trace(ahead, town01, scenic_cache):
     return sample_scenes(ahead, 30, map_path=town01, seed=0)
 
 
@@ -77,22 +68,22 @@ def test_other_car_is_ahead_by_the_sampled_gap(trace):
     assert np.all((heading > -np.pi) & (heading <= np.pi))
 
 
-def test_positions_are_on_the_drivable_area(trace, town01, cache):
+def test_positions_are_on_the_drivable_area(trace, town01, scenic_cache):
     drivable = read_map(town01).drivable
     distance = shapely.distance(drivable, shapely.points(trace.states.x, trace.states.y))
     assert np.all(distance <= 1e-6)
 
 
-def test_map_cache_is_in_the_user_cache(trace, cache):
-    assert len(list(cache.glob("scenic-maps/*/Town01.snet"))) == 1
+def test_map_cache_is_in_the_user_cache(trace, scenic_cache):
+    assert len(list(scenic_cache.glob("scenic-maps/*/Town01.snet"))) == 1
 
 
-def test_seed_reproduces(trace, ahead, town01, cache):
+def test_seed_reproduces(trace, ahead, town01, scenic_cache):
     assert sample_scenes(ahead, 30, map_path=town01, seed=0).equals(trace)
     assert not sample_scenes(ahead, 30, map_path=town01, seed=1).equals(trace)
 
 
-def test_unsatisfiable_program_is_a_one_line_user_error(tmp_path, town01, cache):
+def test_unsatisfiable_program_is_a_one_line_user_error(tmp_path, town01, scenic_cache):
     program = tmp_path / "never.scenic"
     program.write_text(NEVER)
     with pytest.raises(UserError) as caught:

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Iterator, Mapping
 
-from ..errors import UserError, at
+from ..errors import UserError, at, first_line
 
 STDIN = "-"
 """The path that means standard input."""
@@ -41,8 +41,7 @@ def reading(path: str | Path, what: str, *errors: type[BaseException]) -> Iterat
     except FileNotFoundError as exc:
         raise UserError(f"no such file: {exc.filename or path}", at(path)) from None
     except (OSError, *errors) as exc:
-        detail = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise UserError(f"not a valid {what} (truncated or corrupt?): {detail}", at(path)) from None
+        raise UserError(f"not a valid {what} (truncated or corrupt?): {first_line(exc)}", at(path)) from None
 
 
 def field(mapping: Mapping[str, Any], key: str, path: str | Path, where: str) -> Any:

@@ -13,7 +13,6 @@ Scenic is imported inside the functions (about a second), never when this module
 from __future__ import annotations
 
 import contextlib
-import math
 import random
 import shutil
 import traceback
@@ -26,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..cache import cache_dir, file_digest
-from ..errors import SourceLocation, UserError, at
+from ..errors import SourceLocation, UserError, at, first_line
 from ..model.geometry import normalize_angle
 
 
@@ -118,12 +117,6 @@ def scenic_errors(program: Path) -> Iterator[None]:
         raise UserError(f"{type(exc).__name__}: {first_line(exc)}", location) from None
 
 
-def first_line(exc: BaseException) -> str:
-    """The first line of an exception's message (its type name when it has none)."""
-    text = str(exc).strip()
-    return text.splitlines()[0] if text else type(exc).__name__
-
-
 def _location(exc: BaseException, program: Path) -> SourceLocation | None:
     """Where in the program an exception points: its own line and (1-based) column when it is
     a syntax error in the program, else the innermost traceback frame running the program."""
@@ -139,6 +132,6 @@ def _location(exc: BaseException, program: Path) -> SourceLocation | None:
     return at(program, innermost.lineno, None if innermost.colno is None else innermost.colno + 1)
 
 
-def scenic_heading(value: float) -> float:
-    """A Scenic heading in (-pi, pi]; values already there are kept bit for bit."""
-    return float(value) if -math.pi < value <= math.pi else float(normalize_angle(value))
+def scenic_headings(values: np.ndarray) -> np.ndarray:
+    """Scenic headings (radians) in (-pi, pi]; values already there are kept bit for bit."""
+    return np.where((values > -np.pi) & (values <= np.pi), values, normalize_angle(values))

@@ -35,7 +35,7 @@ from ._scenic import (
     compile_program,
     map_params,
     scenic_errors,
-    scenic_heading,
+    scenic_headings,
     scenic_version,
     seed_scenic,
 )
@@ -97,9 +97,9 @@ def _objects(scenes: Sequence[Any], program: Path) -> tuple[list[str], list[str]
 def _states(scenes: Sequence[Any]) -> StateTable:
     """One state row per (scene, object) with Scenic's exact values."""
     rows = [
-        (k, j, o.position.x, o.position.y, scenic_heading(o.heading), o.length, o.width, o.height)
+        (k, j, o.position.x, o.position.y, o.heading, o.length, o.width, o.height)
         for k, scene in enumerate(scenes)
         for j, o in enumerate(scene.objects)
     ]
     frame, obj, x, y, heading, length, width, height = np.array(rows, dtype=np.float64).reshape(-1, 8).T
-    return StateTable.build(frame, obj, x, y, heading, length=length, width=width, height=height)
+    return StateTable.build(frame, obj, x, y, scenic_headings(heading), length=length, width=width, height=height)

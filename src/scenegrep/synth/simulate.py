@@ -43,8 +43,15 @@ import numpy as np
 
 from ..errors import UserError, at
 from ..model import BehaviourLabels, LabelTrace, MapSource, ObjectTable, StateTable
-from ..model.geometry import normalize_angle
-from ._scenic import checked_inputs, compile_program, map_params, scenic_errors, scenic_version, seed_scenic
+from ._scenic import (
+    checked_inputs,
+    compile_program,
+    map_params,
+    scenic_errors,
+    scenic_headings,
+    scenic_version,
+    seed_scenic,
+)
 from .noise import LabelNoise, add_noise
 from .running import behaviour_stack, observe_steps, primitive_label
 
@@ -187,7 +194,7 @@ class _Recorder:
             obj,
             x,
             y,
-            np.where((heading > -np.pi) & (heading <= np.pi), heading, normalize_angle(heading)),
+            scenic_headings(heading),
             length=length,
             width=width,
             height=height,
@@ -204,7 +211,7 @@ class _Recorder:
             ObjectTable.build(ids, [type(o).__name__ for o in self.objects]),
             states,
             lane_ids=lane_ids,
-            behaviours=_labels([primitive_label(s) for s in self.stacks]),
+            behaviours=BehaviourLabels.from_sets([{primitive_label(s)} for s in self.stacks]),
             ego="ego" if self.ego is not None else None,
             attributes=attributes,
             map_source=source,
@@ -233,12 +240,3 @@ class _Recorder:
             if not history or history[-1][1] != list(stack):
                 history.append([step, list(stack)])
         return changes
-
-
-def _labels(names: list[str]) -> BehaviourLabels:
-    """One-label sets, one per state row."""
-    vocabulary = tuple(dict.fromkeys(names))
-    code = {name: k for k, name in enumerate(vocabulary)}
-    member = np.zeros((len(names), len(vocabulary)), dtype=bool)
-    member[np.arange(len(names)), [code[n] for n in names]] = True
-    return BehaviourLabels(vocabulary, member)

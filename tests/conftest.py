@@ -43,3 +43,13 @@ def maps_dir() -> Path:
 def conformance_dir() -> Path:
     """../shared/conformance (skips the test when absent)."""
     return _folder("conformance")
+
+
+@pytest.fixture(scope="session")
+def scenic_cache(tmp_path_factory):
+    """A fresh scenegrep cache (``$SCENEGREP_CACHE``) for the tests that simulate with Scenic, so each
+    CARLA town is parsed by Scenic once per test process (seconds) rather than once per test."""
+    folder = tmp_path_factory.mktemp("scenic-cache")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("SCENEGREP_CACHE", str(folder))
+        yield folder

@@ -1,5 +1,7 @@
 """LabelTrace: invariants, dense views, slicing by time and by object (against brute force)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -111,3 +113,24 @@ def test_select_frames_keeps_every_object():
     kept = trace.select_frames(np.array([False, False, True, True]))
     assert kept.n_frames == 2 and kept.n_objects == 2 and len(kept.states) == 2
     assert kept.frame_time.tolist() == trace.frame_time[2:].tolist()
+
+
+@given(label_traces(), st.data())
+def test_concatenate_puts_frames_one_after_the_other_with_objects_by_id(trace, data):
+    from scenegrep.model import concatenate
+
+    if trace.images is not None:
+        trace = replace(trace, images=None)
+    cut = data.draw(st.integers(0, trace.n_frames))
+    joined = concatenate([trace.slice_frames(0, cut), trace.slice_frames(cut, trace.n_frames)])
+    assert joined.n_frames == trace.n_frames
+    assert np.array_equal(joined.frame_index, trace.frame_index)
+    for obj in set(trace.objects.id[trace.states.object].tolist()):
+        a = joined.states.take(joined.states.object == joined.object_index(obj))
+        b = trace.states.take(trace.states.object == trace.object_index(obj))
+        assert np.array_equal(a.frame, b.frame) and np.array_equal(a.x, b.x, equal_nan=True)
+        if trace.behaviours is not None:
+            rows_a = np.flatnonzero(joined.states.object == joined.object_index(obj))
+            rows_b = np.flatnonzero(trace.states.object == trace.object_index(obj))
+            sets_a, sets_b = joined.behaviours.sets(), trace.behaviours.sets()
+            assert [sets_a[r] for r in rows_a] == [sets_b[r] for r in rows_b]

@@ -113,7 +113,9 @@ def test_every_specifier_becomes_an_ir_node(specifier, name, operands):
         ("while True:\n    pass\n", "while loops are not supported", 1, 1),
         ("for i in [1, 2]:\n    pass\n", "only loops of the form", 1, 1),
         ("ego = new Car on\n", "Scenic syntax error", 1, 17),
-        ("behavior B():\n    wait\n", "behaviours are not supported", 1, 1),
+        ("behavior B():\n    if True:\n        wait\n", "'if' is not supported in a behaviour", 2, 5),
+        ("behavior B():\n    do A(), C()\n", "several behaviours at once", 2, 5),
+        ("behavior B():\n    do choose A(), C()\n", "'do choose' is not supported", 2, 5),
     ],
 )
 def test_unsupported_constructs_are_rejected_with_their_place(text, message, line, column):

@@ -10,7 +10,7 @@ from .behaviours import BehaviourLabels
 from .images import BoxTable, ImageLayer, SampleTable
 from .objects import ObjectTable
 from .states import StateTable
-from .trace import LabelTrace, MapSource, TraceSource
+from .trace import LabelTrace, MapSource, TraceSource, concatenate
 
 _ROADMAP = ("Area", "Lane", "LaneNeighbour", "RoadMap")
 
@@ -28,6 +28,7 @@ __all__ = [
     "SampleTable",
     "StateTable",
     "TraceSource",
+    "concatenate",
 ]
 
 

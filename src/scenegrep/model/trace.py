@@ -236,3 +236,68 @@ def _optional_equal(a: Any, b: Any) -> bool:
     if a is None or b is None:
         return a is None and b is None
     return bool(a.equals(b))
+
+
+def concatenate(traces: list[LabelTrace]) -> LabelTrace:
+    """The frames of ``traces`` one after the other (e.g. chunks of a stream); objects with the same
+    id are the same object. Name, ego, attributes and map come from the first trace; behaviour
+    labels are kept if every trace has them; image layers are not concatenated (ValueError)."""
+    if any(t.images is not None for t in traces):
+        raise ValueError("traces with image layers cannot be concatenated")
+    ids: dict[str, int] = {}
+    categories: list[str] = []
+    attributes: list[dict[str, Any]] = []
+    lanes: dict[str, int] = {}
+    parts = []
+    offset = 0
+    for trace in traces:
+        object_map = np.array([ids.setdefault(str(i), len(ids)) for i in trace.objects.id], dtype=np.int32)
+        for row in np.flatnonzero(object_map >= len(categories)):
+            categories.append(str(trace.objects.category[row]))
+            attributes.append(dict(trace.objects.attributes[row]))
+        lane_map = np.array([lanes.setdefault(name, len(lanes)) for name in trace.lane_ids] + [-1], dtype=np.int32)
+        states = trace.states
+        parts.append(
+            replace(
+                states,
+                frame=(states.frame + offset).astype(np.int32),
+                object=object_map[states.object],
+                lane=lane_map[states.lane],
+            )
+        )
+        offset += trace.n_frames
+    states = StateTable(**{name: np.concatenate([p.columns()[name] for p in parts]) for name in parts[0].columns()})
+    labelled = [t.behaviours for t in traces if t.behaviours is not None]
+    behaviours = _concatenate_labels(labelled) if len(labelled) == len(traces) else None
+    first = traces[0]
+    return LabelTrace.build(
+        first.name,
+        np.concatenate([t.frame_index for t in traces]),
+        np.concatenate([t.frame_time for t in traces]),
+        ObjectTable.build(list(ids), categories, attributes),
+        states,
+        lane_ids=tuple(lanes),
+        behaviours=behaviours,
+        ego=first.ego,
+        attributes=first.attributes,
+        source=first.source,
+        map_source=first.map_source,
+    )
+
+
+def _concatenate_labels(parts: list[BehaviourLabels]) -> BehaviourLabels:
+    """Behaviour labels stacked row-wise over the union of their vocabularies (confidences dropped
+    unless every part has them)."""
+    vocabulary = list(dict.fromkeys(name for part in parts for name in part.vocabulary))
+    column = {name: k for k, name in enumerate(vocabulary)}
+    member = np.zeros((sum(len(p.member) for p in parts), len(vocabulary)), dtype=bool)
+    scored = all(p.confidence is not None for p in parts)
+    confidence = np.full(member.shape, np.nan, dtype=np.float32) if scored else None
+    row = 0
+    for part in parts:
+        cols = [column[name] for name in part.vocabulary]
+        member[row : row + len(part.member), cols] = part.member
+        if confidence is not None:
+            confidence[row : row + len(part.member), cols] = part.confidence
+        row += len(part.member)
+    return BehaviourLabels(tuple(vocabulary), member, confidence)

@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from .program import Feature, Requirement, SceneProgram
-from .terms import Term
+from .terms import Term, leaf_dependencies
 
 RANDOM_LEAVES = ("var", "choice", "point")
 
@@ -31,13 +31,15 @@ class Group:
     requirements: list[Requirement] = field(default_factory=list)
     introduces: list[str] = field(default_factory=list)
     unknowns: frozenset[Term] = frozenset()
+    objects: frozenset[str] = frozenset()
+    """Every program object whose features the group reads (its own and those its terms observe)."""
 
     def describe(self) -> str:
         parts = [repr(f) for f in self.features] + [r.description for r in self.requirements]
         return ", ".join(parts)
 
 
-def _randoms(term: Term) -> set[Term]:
+def random_leaves(term: Term) -> set[Term]:
     leaves = set(term.leaves())
     if term.op in RANDOM_LEAVES:
         leaves.add(term)
@@ -45,7 +47,7 @@ def _randoms(term: Term) -> set[Term]:
 
 
 def _observed(term: Term) -> set[tuple[str, str]]:
-    leaves = set(term.leaves()) | {term}
+    leaves = set(term.leaves()) | {term} | leaf_dependencies(term)
     return {leaf.value for leaf in leaves if leaf.op == "observed"}
 
 
@@ -72,7 +74,7 @@ def analyse(scene: SceneProgram, requirements: list[Requirement] | None = None) 
     chosen = [r for r in scene.requirements if not r.soft] if requirements is None else requirements
     items: list[Feature | Requirement] = [*features, *chosen]
     terms = [item.term if isinstance(item, Feature) else item.condition for item in items]
-    randoms = [_randoms(t) for t in terms]
+    randoms = [random_leaves(t) for t in terms]
     sets = _UnionFind(len(items))
     owner: dict[object, int] = {}
     for i, leaves in enumerate(randoms):
@@ -174,5 +176,25 @@ def _groups(
                         introduced.add(obj)
                         group.introduces.append(obj)
         group.unknowns = frozenset(unknowns)
+        group.objects = frozenset(
+            o for root in component for i in members[root] for o, _ in reads[i] if o in object_order
+        )
         groups.append(group)
     return groups
+
+
+def completed_groups(groups: list[Group], assigned: set[str], newest: str) -> list[Group]:
+    """The groups a partial correspondence of ``assigned`` objects decides that involve ``newest``
+    (or no object at all, when ``newest`` is the only one assigned), with ``introduces`` recomputed
+    for that sub-list: checking them prunes the partial correspondence (seed 003's badOCs)."""
+    chosen = [
+        g for g in groups if g.objects <= assigned and (newest in g.objects or (not g.objects and assigned == {newest}))
+    ]
+    introduced: set[str] = set()
+    restricted = []
+    for group in chosen:
+        new = [o for o in group.introduces if o not in introduced]
+        new += sorted(group.objects - introduced - set(new))
+        introduced.update(new)
+        restricted.append(Group(group.features, group.requirements, new, group.unknowns, group.objects))
+    return restricted

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from .decide import Tolerance, _decide_expanded, closed_form_witness, decide
-from .dependencies import Group, _randoms
+from .dependencies import Group, random_leaves
 from .evaluate import Evaluator, Labels, Rows
 from .geometry import MapGeometry
 from .match import TraceMatches
@@ -83,7 +83,7 @@ def soft_requirements(
     found: dict[str, np.ndarray] = {}
     rows: Rows = matches.survivors
     for requirement in (r for r in program.requirements if r.soft):
-        group = Group(requirements=[requirement], unknowns=frozenset(_randoms(requirement.condition)))
+        group = Group(requirements=[requirement], unknowns=frozenset(random_leaves(requirement.condition)))
         if not len(rows):
             found[requirement.description] = np.zeros(0, dtype=bool)
             continue

@@ -33,13 +33,15 @@ from .program import ProgramObject, SceneProgram
 
 @dataclass(frozen=True)
 class SceneOptions:
-    """How to match: tolerances, ``exact`` (surjective correspondence), visible distance (m), and a
-    known (partial) correspondence, program object -> label object id, to check instead of search."""
+    """How to match: tolerances, ``exact`` (surjective correspondence), visible distance (m), a
+    known (partial) correspondence, program object -> label object id, to check instead of search,
+    and the frame positions to check (None: all; the others are reported as not matching)."""
 
     tolerance: Tolerance = field(default_factory=Tolerance)
     exact: bool = False
     visible_distance: float | None = None
     correspondence: dict[str, str] | None = None
+    frames: np.ndarray | None = None
 
 
 @dataclass
@@ -133,7 +135,8 @@ def match_trace(
     labels = labels_of(trace)
     objects = {o.name: o for o in scene.objects}
     candidates = Candidates(trace, options)
-    rows = Rows(np.arange(trace.n_frames), {})
+    frames = np.arange(trace.n_frames) if options.frames is None else np.asarray(options.frames, dtype=np.intp)
+    rows = Rows(frames, {})
     failed = np.full(trace.n_frames, -1, dtype=np.intp)
     notes: Counter = Counter()
     for g, group in enumerate(groups):

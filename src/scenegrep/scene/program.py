@@ -46,8 +46,9 @@ class Feature:
 @dataclass(frozen=True, eq=False)
 class ProgramObject:
     """A scene object of the program: name (variable, ``ego``, or ``Class@line``), class, label
-    kinds it may match (None: any), features in order x, y, heading[, width, length], and the
-    class defaults of its size (used when a label has none)."""
+    kinds it may match (None: any), features in order x, y, heading[, width, length], the
+    class defaults of its size (used when a label has none), and the behaviour call of its
+    ``with behavior`` specifier (None: no behaviour; only scenario queries read it)."""
 
     name: str
     class_name: str
@@ -55,6 +56,7 @@ class ProgramObject:
     features: tuple[Feature, ...]
     default_size: dict[str, float]
     span: ir.Span
+    behaviour: ir.Call | None = None
 
     @property
     def is_ego(self) -> bool:

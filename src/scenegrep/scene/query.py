@@ -22,6 +22,7 @@ import numpy as np
 from ..errors import UserError, at
 from ..model import LabelTrace, RoadMap
 from ..scenic.adapter import parse_program
+from ..scenic.parser import read_program
 from .dependencies import Group, analyse
 from .geometry import MapGeometry, geometry_of
 from .evaluate import Labels
@@ -98,7 +99,19 @@ class SceneQuery:
         return f"no labeled object can be {' and '.join(names)}: {checks}"
 
     def uses_map(self) -> bool:
-        return bool(_layers(self.program))
+        return bool(self.map_layers)
+
+    @cached_property
+    def map_layers(self) -> set[str]:
+        """The map layers the program's features and requirements read."""
+        return _layers(self.program)
+
+    def frames_matching(
+        self, trace: LabelTrace, geometry: MapGeometry, options: SceneOptions, groups: list[Group]
+    ) -> np.ndarray:
+        """Per frame, whether ``groups`` (a sub-list of this query's groups, see
+        :func:`.dependencies.completed_groups`) hold, on an already resolved map geometry."""
+        return match_trace(self.program, groups, trace, geometry, options).matched
 
     def match(
         self, trace: LabelTrace, road_map: RoadMap | None = None, options: SceneOptions | None = None
@@ -114,12 +127,17 @@ class SceneQuery:
                 f"the program names map layers the road map of trace {trace.name!r} does not have: {names}",
                 at(self.program.program.filename),
             )
-        groups = self._groups_for(trace)
+        groups = self.groups_for(trace)
         matches = match_trace(self.program, groups, trace, geometry, options)
         return SceneResult(trace, self, matches, labels_of(trace), geometry, options)
 
     def _map_for(self, trace: LabelTrace, road_map: RoadMap | None) -> RoadMap | None:
-        if road_map is not None or not self.uses_map():
+        return self.map_for(trace, road_map, self.uses_map())
+
+    def map_for(self, trace: LabelTrace, road_map: RoadMap | None, needed: bool) -> RoadMap | None:
+        """The road map to use: ``road_map`` if given, else (when ``needed``) the trace's own map,
+        else the program's ``param map``; an error when a needed map is missing."""
+        if road_map is not None or not needed:
             return road_map
         from ..readers import read_map
 
@@ -132,7 +150,7 @@ class SceneQuery:
             at(self.program.program.filename),
         )
 
-    def _groups_for(self, trace: LabelTrace) -> list[Group]:
+    def groups_for(self, trace: LabelTrace) -> list[Group]:
         """The groups, without parameter checks for attributes the trace does not have."""
         dropped = {
             r for r in self.program.requirements if r.parameter is not None and r.parameter not in trace.attributes
@@ -142,7 +160,7 @@ class SceneQuery:
         return analyse(self.program, [r for r in self.program.requirements if not r.soft and r not in dropped])
 
 
-def _term_layers(term: Term) -> set[str]:
+def term_layers(term: Term) -> set[str]:
     """The map layers a term reads, through its regions, fields and random points."""
     layers: set[str] = set()
     seen: set[int] = set()
@@ -165,9 +183,9 @@ def _layers(program: SceneProgram) -> set[str]:
     layers: set[str] = set()
     for obj in program.objects:
         for feature in obj.features:
-            layers |= _term_layers(feature.term)
+            layers |= term_layers(feature.term)
     for requirement in program.requirements:
-        layers |= _term_layers(requirement.condition)
+        layers |= term_layers(requirement.condition)
     return layers
 
 
@@ -182,11 +200,4 @@ def compile_scene(text: str, filename: str = "<program>", visible_distance: floa
 
 def load_scene(path: str | Path, visible_distance: float | None = None) -> SceneQuery:
     """Compile a ``.scenic`` file."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise UserError("no such file", at(path)) from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise UserError(f"cannot read the program: {error}", at(path)) from None
-    return compile_scene(text, str(path), visible_distance)
+    return compile_scene(read_program(path), str(path), visible_distance)

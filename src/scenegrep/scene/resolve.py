@@ -73,6 +73,8 @@ class Resolver:
         self.instances: list[Instance] = []
         self.suffix = ""
         self.self_view: Any = None
+        self.behaviours: dict[str, ir.BehaviourDef] = {}
+        """The program's behaviour definitions by name (they do not shape the scene; see :mod:`scenegrep.scenario`)."""
 
     def error(self, message: str, where: ir.Node | ir.Span) -> UserError:
         return program_error(message, where, self.program)
@@ -102,6 +104,8 @@ class Resolver:
             self.require(node)
         elif isinstance(node, ir.Repeat):
             self.repeat(node)
+        elif isinstance(node, ir.BehaviourDef):
+            self.behaviours[node.name] = node
         else:
             raise self.error(f"{type(node).__name__} statements are not supported", node)
 
@@ -133,7 +137,7 @@ class Resolver:
         condition = expressions.to_bool(self, self.evaluate(node.condition, name=None), node.condition)
         if node.probability is not None and not 0 <= node.probability <= 1:
             raise self.error("a require probability must lie in [0, 1]", node)
-        text = _source_text(self.program, node.condition.span)
+        text = source_text(self.program, node.condition.span)
         self.scene.requirements.append(Requirement(condition, f"require {text}", node.span, node.probability))
 
     def repeat(self, node: ir.Repeat) -> None:
@@ -199,7 +203,7 @@ class Resolver:
 
     def label(self, node: ir.Node) -> str:
         """How a random value is named in explanations: its source text and place, ``Range(4, 10)@2:36``."""
-        text = _source_text(self.program, node.span)
+        text = source_text(self.program, node.span)
         text = text if len(text) <= 40 else text[:37] + "..."
         if self.program.filename.startswith("<default "):
             return f"{text} ({self.program.filename[1:-1]}){self.suffix}"
@@ -211,7 +215,7 @@ class Resolver:
         return str((folder / relative).resolve())
 
 
-def _source_text(program: ir.Program, span: ir.Span) -> str:
+def source_text(program: ir.Program, span: ir.Span) -> str:
     """The program text of a one-line span, or its first line."""
     lines = program.text.splitlines()
     if not 0 < span.line <= len(lines):

@@ -128,7 +128,8 @@ def construct(r: Resolver, node: ir.New, name: str) -> Instance:
     instance = Instance(name, spec, node.span)
     if spec.is_object:
         instance.observed = observed_view(r.f, name)
-    effects = [_effect(r, s) for s in node.specifiers]
+    behaviour = _behaviour_call(r, node)
+    effects = [_effect(r, s) for s in node.specifiers if s.property != "behavior"]
     chosen, modifiers = _choose(r, effects)
     sources: dict[str, Effect | Default] = dict(chosen)
     for prop in defaulted_properties(spec.name):
@@ -147,8 +148,25 @@ def construct(r: Resolver, node: ir.New, name: str) -> Instance:
     _check_types(r, instance, node)
     r.instances.append(instance)
     if spec.is_object:
-        _add_scene_object(r, instance, chosen, modifiers, node)
+        _add_scene_object(r, instance, chosen, modifiers, node, behaviour)
+    elif behaviour is not None:
+        raise r.error(f"a {spec.name} cannot have a behaviour", behaviour)
     return instance
+
+
+def _behaviour_call(r: Resolver, node: ir.New) -> ir.Call | None:
+    """The call of the ``with behavior`` specifier, if any (behaviours do not shape the scene)."""
+    found = [s for s in node.specifiers if s.property == "behavior"]
+    if not found:
+        return None
+    if len(found) > 1:
+        raise r.error("the behaviour is specified twice", found[1])
+    value = found[0].operands[0]
+    if isinstance(value, ir.Name):
+        return ir.Call(value.id, (), span=value.span)
+    if not isinstance(value, ir.Call):
+        raise r.error("a behaviour must be a behaviour call such as FollowLaneBehavior()", found[0])
+    return value
 
 
 def _choose(r: Resolver, effects: list[Effect]) -> tuple[dict[str, Effect], list[Effect]]:
@@ -183,7 +201,12 @@ def _check_types(r: Resolver, instance: Instance, node: ir.New) -> None:
 
 
 def _add_scene_object(
-    r: Resolver, obj: Instance, chosen: dict[str, Effect], modifiers: list[Effect], node: ir.New
+    r: Resolver,
+    obj: Instance,
+    chosen: dict[str, Effect],
+    modifiers: list[Effect],
+    node: ir.New,
+    behaviour: ir.Call | None,
 ) -> None:
     position: Vec = obj.defining["position"]
     features = [
@@ -201,7 +224,7 @@ def _add_scene_object(
         default = r.evaluate_default(default_expression(obj.spec.name, size))  # type: ignore[arg-type]
         default_size[size] = float(default.value)
     r.scene.objects.append(
-        ProgramObject(obj.name, obj.spec.name, obj.spec.kinds, tuple(features), default_size, obj.span)
+        ProgramObject(obj.name, obj.spec.name, obj.spec.kinds, tuple(features), default_size, obj.span, behaviour)
     )
     _add_implicit_requirements(r, obj, modifiers, node)
 

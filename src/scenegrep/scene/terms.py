@@ -101,7 +101,7 @@ class Term:
                 if child.op in LEAVES:
                     if child.op != "const":
                         found.add(child)
-                    found.update(_leaf_dependencies(child))
+                    found.update(leaf_dependencies(child))
                 else:
                     found.update(child.leaves())
             self._leaves = frozenset(found)
@@ -123,8 +123,9 @@ def value_terms(value: Any) -> Iterator[Term]:
             yield from value_terms(item)
 
 
-def _leaf_dependencies(leaf: Term) -> set[Term]:
-    """Leaves a leaf itself depends on: the bounds of a random variable, the region of a random point."""
+def leaf_dependencies(leaf: Term) -> set[Term]:
+    """Leaves a leaf itself depends on: the bounds of a random variable, the region of a random point
+    (empty for other terms)."""
     if leaf.op == "var":
         return set(leaf.value.low.leaves() | leaf.value.high.leaves()) | {
             t for t in (leaf.value.low, leaf.value.high) if t.op in LEAVES and t.op != "const"

@@ -5,8 +5,11 @@ Scenic 3.1.1's parser returns a Python ``ast.Module`` whose nodes are Python's
 ``DirectionOfSpecifier`` ...). Nodes are dispatched on their class *name*, so the
 adapter works whichever copy of Scenic's node classes produced them (see
 :mod:`.parser`). Everything outside the supported fragment (imports, function or
-class definitions, behaviours, loops other than ``for i in range(n)``, method
+class definitions, monitors, loops other than ``for i in range(n)``, method
 calls, subscripts) is rejected with its line and column, never skipped.
+Behaviour bodies keep seed 000's fragment: ``do``, ``do ... until``,
+``do ... for``, sequences, ``try``/``interrupt when``, and ``while True:`` loops
+of ``take``/``wait`` (a user-defined primitive behaviour).
 """
 
 from __future__ import annotations
@@ -89,7 +92,6 @@ _UNSUPPORTED_STATEMENTS = {
     "FunctionDef": "function definitions are not supported",
     "AsyncFunctionDef": "function definitions are not supported",
     "ClassDef": "class definitions are not supported",
-    "BehaviorDef": "behaviours are not supported by scene queries",
     "MonitorDef": "monitors are not supported",
     "ScenarioDef": "modular scenarios are not supported",
     "If": "if statements are not supported",
@@ -173,6 +175,64 @@ class Adapter:
             raise self.error("only loops of the form 'for name in range(count):' are supported", node)
         body = self.statements(node.body)
         return [ir.Repeat(node.target.id, self.expr(iterator.args[0]), body, span=self.span(node))]
+
+    def stmt_BehaviorDef(self, node: Any) -> list[ir.Node]:
+        args = node.args
+        if args.posonlyargs or args.kwonlyargs or args.vararg or args.kwarg:
+            raise self.error("behaviour parameters must be plain names (no *args, **kwargs or keyword-only)", node)
+        if node.header:
+            raise self.error("behaviour preconditions and invariants are not supported", node.header[0])
+        params = tuple(a.arg for a in args.args)
+        padding: list[ir.Node | None] = [None] * (len(params) - len(args.defaults))
+        defaults = tuple(padding + [self.expr(d) for d in args.defaults])
+        body = self.behaviour_body(node.body, node)
+        return [ir.BehaviourDef(node.name, params, defaults, body, span=self.span(node))]
+
+    # ---------------------------------------------------------------- behaviour bodies
+    def behaviour_body(self, body: list[ast.AST], owner: ast.AST) -> tuple[ir.Node, ...]:
+        out = [s for s in (self.behaviour_statement(node) for node in body) if s is not None]
+        if not out:
+            raise self.error("a behaviour block must do something (do, take or wait)", owner)
+        return tuple(out)
+
+    def behaviour_statement(self, node: Any) -> ir.Node | None:
+        kind = type(node).__name__
+        span = self.span(node)
+        if kind == "Expr" and type(node.value).__name__ == "Constant" and isinstance(node.value.value, str):
+            return None
+        if kind == "Pass":
+            return None
+        if kind in ("Take", "Wait"):
+            return ir.Take(span=span)
+        if kind == "Do":
+            return ir.Do(self.behaviour_call(node), span=span)
+        if kind == "DoUntil":
+            return ir.DoUntil(self.behaviour_call(node), self.expr(node.cond), span=span)
+        if kind == "DoFor":
+            unit = "steps" if type(node.duration).__name__ == "Steps" else "seconds"
+            return ir.DoFor(self.behaviour_call(node), self.expr(node.duration.value), unit, span=span)
+        if kind == "TryInterrupt":
+            return self.try_interrupt(node)
+        if kind == "While" and type(node.test).__name__ == "Constant" and node.test.value is True and not node.orelse:
+            return ir.Forever(self.behaviour_body(node.body, node), span=span)
+        raise self.error(f"{_describe(node)} is not supported in a behaviour (seed 000's fragment)", node)
+
+    def behaviour_call(self, node: Any) -> ir.Call:
+        if len(node.elts) != 1:
+            raise self.error("running several behaviours at once ('do A, B') is not supported", node)
+        call = self.expr(node.elts[0])
+        if not isinstance(call, ir.Call):
+            raise self.error("'do' needs a behaviour call such as FollowLaneBehavior()", node.elts[0])
+        return call
+
+    def try_interrupt(self, node: Any) -> ir.Node:
+        if node.except_handlers or node.orelse or node.finalbody:
+            raise self.error("'except', 'else' and 'finally' are not supported with 'try'", node)
+        handlers = tuple(
+            ir.Interrupt(self.expr(h.cond), self.behaviour_body(h.body, h), span=self.span(h))
+            for h in node.interrupt_when_handlers
+        )
+        return ir.TryInterrupt(self.behaviour_body(node.body, node), handlers, span=self.span(node))
 
     # ---------------------------------------------------------------- expressions
     def expr(self, node: ast.AST) -> ir.Node:

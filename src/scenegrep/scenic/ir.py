@@ -257,6 +257,69 @@ class Repeat(Node):
     body: tuple[Node, ...]
 
 
+# ---------------------------------------------------------------------------- behaviours
+@dataclass(frozen=True)
+class Do(Node):
+    """``do B(args)``: run behaviour call ``behaviour`` (a :class:`Call`) to its end."""
+
+    behaviour: Call
+
+
+@dataclass(frozen=True)
+class DoUntil(Node):
+    """``do B(args) until condition``: run ``behaviour`` until ``condition`` holds (checked before each step)."""
+
+    behaviour: Call
+    condition: Node
+
+
+@dataclass(frozen=True)
+class DoFor(Node):
+    """``do B(args) for amount seconds|steps``: run ``behaviour`` for at most that long."""
+
+    behaviour: Call
+    amount: Node
+    unit: str
+
+
+@dataclass(frozen=True)
+class Interrupt(Node):
+    """``interrupt when condition:`` and its handler ``body``."""
+
+    condition: Node
+    body: tuple[Node, ...]
+
+
+@dataclass(frozen=True)
+class TryInterrupt(Node):
+    """``try: body`` with its ``interrupt when`` handlers, earlier handlers first (higher priority)."""
+
+    body: tuple[Node, ...]
+    handlers: tuple[Interrupt, ...]
+
+
+@dataclass(frozen=True)
+class Take(Node):
+    """``take actions`` or ``wait``: one step of actions (their values are not modelled)."""
+
+
+@dataclass(frozen=True)
+class Forever(Node):
+    """``while True: body``."""
+
+    body: tuple[Node, ...]
+
+
+@dataclass(frozen=True)
+class BehaviourDef(Node):
+    """``behavior name(params): body``; ``defaults`` aligns with ``params`` (None: no default)."""
+
+    name: str
+    params: tuple[str, ...]
+    defaults: tuple[Node | None, ...]
+    body: tuple[Node, ...]
+
+
 @dataclass(frozen=True)
 class Program(Node):
     """A whole program: its statements, text and file name."""

@@ -75,6 +75,16 @@ def scenic_parser() -> ModuleType:
     return _light_load(Path(next(iter(spec.submodule_search_locations))))
 
 
+def read_program(path: str | Path) -> str:
+    """The text of a ``.scenic`` file; a missing or unreadable file is a one-line :class:`UserError`."""
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise UserError("no such file", at(path)) from None
+    except (OSError, UnicodeDecodeError) as error:
+        raise UserError(f"cannot read the program: {error}", at(path)) from None
+
+
 def parse_scenic(text: str, filename: str) -> ast.Module:
     """Parse Scenic source text with Scenic's parser; syntax errors become one-line :class:`UserError`."""
     try:

@@ -1,0 +1,156 @@
+"""Explanations of scenario answers.
+
+For a match: per step of the window, each program object's label object, observed
+label set, the values of the guards its HFSM reads, the HFSM's possible outputs
+(before pruning, as in seed 000 Table 3) and the states kept after pruning.
+For a non-match: the first reason in pipeline order (trace too short, no candidate
+of a class, no candidate whose own behaviour fits, no injective assignment) or,
+after the search, the correspondence that got furthest, the frame where its run
+died and the object whose observed label its HFSM could not produce there; or,
+when the behaviours fit somewhere, that the initial scene fails at every start.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .automaton import DEAD, INITIAL
+from .hfsm import CAN_FALSE, CAN_TRUE
+from .search import Assignment, Outcome, Search
+from .vocabulary import STATIONARY
+
+if TYPE_CHECKING:
+    from .query import ScenarioQuery
+
+_GUARD_TEXT = {CAN_TRUE: "true", CAN_FALSE: "false", CAN_TRUE | CAN_FALSE: "true or false"}
+
+
+class Explainer:
+    """Builds the explanations of one search (lazily: nothing is computed unless asked)."""
+
+    def __init__(self, query: ScenarioQuery, search: Search, outcome: Outcome):
+        self.query = query
+        self.search = search
+        self.outcome = outcome
+        self.trace = search.obs.trace
+
+    def frame(self, position: int) -> str:
+        index = int(self.trace.frame_index[position])
+        return f"frame {index} (t = {float(self.trace.frame_time[position]):.2f} s)"
+
+    def labels_at(self, row: int, position: int) -> str:
+        state = int(self.search.obs.state_at[position, row])
+        if state < 0:
+            return "not observed"
+        behaviours = self.trace.behaviours
+        assert behaviours is not None
+        names = [behaviours.vocabulary[k] for k in np.flatnonzero(behaviours.member[state])]
+        return "{" + ", ".join(names) + "}"
+
+    def _assignment(self, correspondence: dict[str, str]) -> Assignment:
+        rows = self.trace.objects.row_of()
+        return {name: rows[label] for name, label in correspondence.items()}
+
+    def run(self, obj: str, assignment: Assignment, start: int, steps: int) -> list[tuple[int, set, list[int]]]:
+        """Per step from ``start``: (symbol, possible outputs, DFA state after pruning)."""
+        automaton = self.search.automata[obj]
+        symbols = self.search.symbols(obj, [assignment])[0]
+        state = INITIAL
+        found = []
+        for t in range(start, min(start + steps, len(symbols))):
+            outputs = {o.label for _, o in automaton.outcomes(state, int(symbols[t]))}
+            state = automaton.next(state, int(symbols[t]))
+            found.append((int(symbols[t]), outputs, state))
+            if state == DEAD:
+                break
+        return found
+
+    def witness(self, correspondence: dict[str, str], start: int) -> list[str]:
+        assignment = self._assignment(correspondence)
+        m = self.search.m
+        lines = [
+            f"window {self.frame(start)} to {self.frame(start + m - 1)} ({m} frames); "
+            + ", ".join(f"{name} = {label}" for name, label in correspondence.items())
+        ]
+        runs = {obj: self.run(obj, assignment, start, m) for obj in self.query.hfsms}
+        for step in range(m):
+            position = start + step
+            lines.append(f"step {step}, {self.frame(position)}:")
+            for obj, hfsm in self.query.hfsms.items():
+                symbol, outputs, state = runs[obj][step]
+                automaton = self.search.automata[obj]
+                guards = self._guard_values(obj, symbol)
+                kept = sorted({hfsm.path(c) for c in automaton.sets[state]})
+                lines.append(
+                    f"  {obj} ({correspondence[obj]}): label {self.labels_at(assignment[obj], position)}"
+                    f"{guards}; HFSM outputs {{{', '.join(sorted(outputs))}}}; states: {' | '.join(kept)}"
+                )
+        return lines
+
+    def _guard_values(self, obj: str, symbol: int) -> str:
+        automaton = self.search.automata[obj]
+        inputs = automaton.inputs(symbol)
+        parts = [
+            f"{self.query.guards[g].text} is {_GUARD_TEXT[inputs.guards[g]]}" for g in self.query.hfsms[obj].guards
+        ]
+        return "; " + "; ".join(parts) if parts else ""
+
+    # ---------------------------------------------------------------- non-matches
+    def why_not(self) -> str:
+        out = self.outcome
+        m = self.search.m
+        if self.search.n_starts <= 0:
+            return f"the trace has {self.trace.n_frames} frames, fewer than the window of {m}"
+        for obj, cands in out.candidates.items():
+            if not cands:
+                program_object = self.query.scene.program.object(obj)
+                return (
+                    f"no label object that can be {obj} ({program_object.class_name}) is observed for "
+                    f"{m} consecutive frames"
+                )
+        for obj, kept in out.unary.items():
+            if not kept:
+                return f"no candidate for {obj} behaves as its HFSM for {m} frames: " + self._furthest_unary(obj)
+        if not out.feasible:
+            names = ", ".join(f"{o} ({len(k)})" for o, k in out.unary.items())
+            return f"the program objects cannot take distinct label objects (candidates: {names})"
+        if out.scene_failures:
+            assignment, starts = out.scene_failures[0]
+            return (
+                f"the behaviours match from {len(starts)} window start(s) with {self._names(assignment)}, "
+                f"but the initial scene holds at none of them (first: {self.frame(int(starts[0]))})"
+            )
+        best = out.best
+        if best is None:
+            return "no correspondence was found"
+        return self._died(best.assignment, best.per_object, best.reach)
+
+    def _furthest_unary(self, obj: str) -> str:
+        cands = self.outcome.candidates[obj]
+        rows = self.search.reach(obj, [{obj: c} for c in cands])
+        outputs = self.search.automata[obj].outputs
+        moving = sum(1 << p for p, label in enumerate(outputs) if label != STATIONARY)
+        admitted = (self.search.obs.accept(outputs)[:, cands] & moving).astype(bool).sum(axis=0)
+        j = max(range(len(cands)), key=lambda k: (int(rows[k].max()), int(admitted[k])))
+        return self._died({obj: cands[j]}, {obj: rows[j]}, rows[j])
+
+    def _names(self, assignment: Assignment) -> str:
+        ids = self.trace.objects.id
+        return ", ".join(f"{name} = {ids[row]}" for name, row in assignment.items())
+
+    def _died(self, assignment: Assignment, per_object: dict[str, np.ndarray], joint: np.ndarray) -> str:
+        start = int(np.argmax(joint))
+        obj = min(per_object, key=lambda o: int(per_object[o][start]))
+        survived = int(per_object[obj][start])
+        position = start + survived
+        steps = self.run(obj, {**assignment}, start, survived + 1) if obj in assignment else []
+        outputs = steps[-1][1] if steps else set()
+        ids = self.trace.objects.id
+        return (
+            f"furthest reach with {self._names(assignment)}: the window from {self.frame(start)} "
+            f"fails at {self.frame(position)}, where {obj} ({ids[assignment[obj]]}) is labelled "
+            f"{self.labels_at(assignment[obj], position)} but its HFSM could output "
+            f"{{{', '.join(sorted(outputs))}}}"
+        )

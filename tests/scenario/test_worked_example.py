@@ -50,7 +50,7 @@ def test_witness_lists_each_step_with_labels_guards_and_states(fig1):
     assert "ego = car2" in lines[0] and "otherCar = car1" in lines[0]
     step2 = lines[lines.index(next(line for line in lines if line.startswith("step 2"))) + 1]
     assert "label {LaneChange}" in step2 and "is true or false" in step2
-    assert "HFSM outputs {FollowLane, LaneChange}" in step2 and "interrupt 1 > LaneChange" in step2
+    assert "HFSM outputs {FollowLane, LaneChange}" in step2 and "interrupt (line 13) > LaneChange" in step2
 
 
 def test_section2_turn_left_trace_does_not_match(fig1):

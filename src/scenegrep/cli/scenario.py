@@ -19,6 +19,8 @@ import json
 import sys
 from typing import Any
 
+from .scene import add_tolerance_arguments, tolerance_of
+
 NO_MATCH = 1
 
 
@@ -35,12 +37,8 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "--window", required=True, metavar="M", help="window length: frames (50), seconds (5s) or 'all'"
     )
-    parser.add_argument("--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr file)")
+    add_tolerance_arguments(parser)
     parser.add_argument("--vocabulary", metavar="FILE", help="primitive behaviours -> dataset labels (TOML)")
-    parser.add_argument(
-        "--tolerance-position", type=float, default=1e-6, metavar="M", help="position and size tolerance (m)"
-    )
-    parser.add_argument("--tolerance-heading", type=float, default=1e-6, metavar="RAD", help="heading tolerance (rad)")
     parser.add_argument(
         "--visible-distance", type=float, metavar="M", help="initial scene: ignore objects farther than M from the ego"
     )
@@ -92,14 +90,9 @@ def _print(record: dict[str, Any], args: argparse.Namespace) -> None:
 
 
 def _options(args: argparse.Namespace) -> Any:
-    from ..errors import UserError
-    from ..scene import Tolerance
     from ..scenario import ScenarioOptions
 
-    if args.tolerance_position < 0 or args.tolerance_heading < 0:
-        raise UserError("tolerances must not be negative")
-    tolerance = Tolerance(args.tolerance_position, args.tolerance_heading)
-    return ScenarioOptions(tolerance, args.visible_distance, args.all)
+    return ScenarioOptions(tolerance_of(args), args.visible_distance, args.all)
 
 
 def _labelled(trace: Any, road_map: Any, args: argparse.Namespace) -> Any:

@@ -30,11 +30,7 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("program", metavar="PROGRAM", help="a .scenic file")
     parser.add_argument("data", nargs="+", metavar="DATA", help="labeled traces (files or recording directories)")
-    parser.add_argument("--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr file)")
-    parser.add_argument(
-        "--tolerance-position", type=float, default=1e-6, metavar="M", help="position and size tolerance (m)"
-    )
-    parser.add_argument("--tolerance-heading", type=float, default=1e-6, metavar="RAD", help="heading tolerance (rad)")
+    add_tolerance_arguments(parser)
     parser.add_argument("--exact", action="store_true", help="every labeled object in view must be matched")
     parser.add_argument(
         "--visible-distance", type=float, metavar="M", help="ignore objects and map farther than M from the ego"
@@ -45,6 +41,25 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--parquet", metavar="FILE", help="also write the matches as a Parquet table")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
     parser.set_defaults(run=run)
+
+
+def add_tolerance_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--map`` and the scene tolerances, shared by the Scenic query commands."""
+    parser.add_argument("--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr file)")
+    parser.add_argument(
+        "--tolerance-position", type=float, default=1e-6, metavar="M", help="position and size tolerance (m)"
+    )
+    parser.add_argument("--tolerance-heading", type=float, default=1e-6, metavar="RAD", help="heading tolerance (rad)")
+
+
+def tolerance_of(args: argparse.Namespace) -> Any:
+    """The :class:`~scenegrep.scene.Tolerance` the options give (negative values are user errors)."""
+    from ..errors import UserError
+    from ..scene import Tolerance
+
+    if args.tolerance_position < 0 or args.tolerance_heading < 0:
+        raise UserError("tolerances must not be negative")
+    return Tolerance(args.tolerance_position, args.tolerance_heading)
 
 
 def _value_text(values: dict[str, Any]) -> str:
@@ -103,15 +118,10 @@ def _line(record: dict[str, Any], args: argparse.Namespace) -> str:
 
 def run(args: argparse.Namespace) -> int:
     from .. import readers
-    from ..errors import UserError
-    from ..scene import SceneOptions, Tolerance, load_scene
+    from ..scene import SceneOptions, load_scene
 
-    if args.tolerance_position < 0 or args.tolerance_heading < 0:
-        raise UserError("tolerances must not be negative")
     query = load_scene(args.program, args.visible_distance)
-    options = SceneOptions(
-        Tolerance(args.tolerance_position, args.tolerance_heading), args.exact, args.visible_distance
-    )
+    options = SceneOptions(tolerance_of(args), args.exact, args.visible_distance)
     road_map = readers.read_map(args.map) if args.map else None
     rows: list[dict[str, Any]] = []
     found = False

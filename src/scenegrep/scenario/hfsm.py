@@ -7,14 +7,16 @@ is the hashable record of which states are active (a nested tuple; ``None`` for 
 state not yet started). One step runs as Scenic 3.1.1 runs a behaviour
 (``scenic/core/dynamics/invocables.py``):
 
-* a ``try`` checks its handlers in order before each step: a running handler
-  runs on, an earlier one whose condition holds pre-empts it (the pre-empted one
-  stays suspended), and the body runs only when no handler is enabled or
+* a ``try`` checks its handlers in priority order before each step (Scenic gives
+  the handler written last the highest priority): a running handler runs on, a
+  higher one whose condition holds pre-empts it (the pre-empted one stays
+  suspended), and the body runs only when no handler is enabled or
   running; a finished handler lets the selection run again in the same step; a
   finished body ends the ``try``;
 * ``until`` conditions are checked before each step, including the first; a met
   condition ends the statement and the next one runs in the same step;
-* ``do X for T`` runs X while fewer than T steps (or T seconds) have elapsed;
+* ``do X for T`` runs X while fewer than T steps (or T seconds) have elapsed since it
+  started, counting the steps during which a handler suspended it (simulation time);
 * a primitive may end at any step (its end is not observable) unless the
   vocabulary says it never ends; a statement that ends hands the step to the next.
 
@@ -26,6 +28,7 @@ both, and the step is then nondeterministic. :meth:`Hfsm.step` returns every
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
@@ -79,6 +82,11 @@ class State:
         """The names of the active states from this one down to the running base state."""
         raise NotImplementedError
 
+    def tick(self, config: Config, step: StepInputs) -> Config:
+        """``config`` after a step during which this state was suspended by an interrupt handler:
+        simulation time still passes for the ``for`` statements inside it."""
+        return config
+
     def base_labels(self) -> set[str]:
         """The outputs of every base state below this one."""
         raise NotImplementedError
@@ -131,6 +139,12 @@ class Sequence(State):
         index, child = config
         return self.children[index].path(child)
 
+    def tick(self, config: Config, step: StepInputs) -> Config:
+        if config is None:
+            return None
+        index, child = config
+        return index, self.children[index].tick(child, step)
+
     def base_labels(self) -> set[str]:
         return set().union(*(c.base_labels() for c in self.children))
 
@@ -152,6 +166,9 @@ class DoUntil(State):
 
     def path(self, config: Config) -> list[str]:
         return [self.name, *self.child.path(config)]
+
+    def tick(self, config: Config, step: StepInputs) -> Config:
+        return self.child.tick(config, step)
 
     def base_labels(self) -> set[str]:
         return self.child.base_labels()
@@ -185,18 +202,26 @@ class DoFor(State):
     def path(self, config: Config) -> list[str]:
         return [f"{self.name} (step {config[0]})", *self.child.path(config[1])]
 
+    def tick(self, config: Config, step: StepInputs) -> Config:
+        if config is None:
+            return None
+        elapsed, child = config
+        return min(elapsed + 1, math.ceil(self.limit(step.period))), self.child.tick(child, step)
+
     def base_labels(self) -> set[str]:
         return self.child.base_labels()
 
 
 @dataclass(frozen=True)
 class TryInterrupt(State):
-    """``try: body`` with handlers (guard index, handler state), earlier first; configuration
-    (body configuration, per handler its configuration or None when not running)."""
+    """``try: body`` with handlers (guard index, handler state) in priority order, highest first
+    (Scenic's: the handler written last first), their names, and a configuration (body
+    configuration, per handler its configuration or None when not running)."""
 
     body: State
     handlers: tuple[tuple[int, State], ...]
     name: str
+    handler_names: tuple[str, ...] = ()
 
     def run(self, config: Config, step: StepInputs) -> Iterator[Outcome]:
         body, running = (None, (None,) * len(self.handlers)) if config is None else config
@@ -227,13 +252,26 @@ class TryInterrupt(State):
             if outcome is ENDED:
                 yield from self._select(body, running[:j] + (None,) + running[j + 1 :], step, seen)
             else:
-                yield Output(outcome.label, (body, running[:j] + (outcome.config,) + running[j + 1 :]))
+                suspended = tuple(
+                    h.tick(c, step) if c is not None and k != j else c
+                    for k, ((_, h), c) in enumerate(zip(self.handlers, running))
+                )
+                after = suspended[:j] + (outcome.config,) + suspended[j + 1 :]
+                yield Output(outcome.label, (self.body.tick(body, step), after))
+
+    def tick(self, config: Config, step: StepInputs) -> Config:
+        if config is None:
+            return None
+        body, running = config
+        ticked = tuple(None if c is None else h.tick(c, step) for (_, h), c in zip(self.handlers, running))
+        return self.body.tick(body, step), ticked
 
     def path(self, config: Config) -> list[str]:
         body, running = config
         for j, (_, handler) in enumerate(self.handlers):
             if running[j] is not None:
-                return [f"{self.name}: interrupt {j + 1}", *handler.path(running[j])]
+                label = self.handler_names[j] if self.handler_names else f"interrupt {j + 1}"
+                return [f"{self.name}: {label}", *handler.path(running[j])]
         return [f"{self.name}: body", *self.body.path(body)]
 
     def base_labels(self) -> set[str]:

@@ -122,11 +122,15 @@ class Translator:
             return H.DoFor(child, amount, node.unit, name)
         if isinstance(node, ir.TryInterrupt):
             body = self.block(node.body, bindings, obj, stack, used)
-            handlers = tuple(
+            written = [
                 (self.guard(h.condition, bindings, obj, used), self.block(h.body, bindings, obj, stack, used))
                 for h in node.handlers
+            ]
+            names = [f"interrupt (line {h.span.line})" for h in node.handlers]
+            # Scenic checks the handler written last first (scenic/syntax/compiler.py reverses them)
+            return H.TryInterrupt(
+                body, tuple(reversed(written)), f"try (line {node.span.line})", tuple(reversed(names))
             )
-            return H.TryInterrupt(body, handlers, f"try (line {node.span.line})")
         if isinstance(node, (ir.Take, ir.Forever)):
             raise self.error(
                 "'take', 'wait' and 'while True' are supported only as a whole primitive behaviour "

@@ -292,7 +292,8 @@ class Interrupt(Node):
 
 @dataclass(frozen=True)
 class TryInterrupt(Node):
-    """``try: body`` with its ``interrupt when`` handlers, earlier handlers first (higher priority)."""
+    """``try: body`` with its ``interrupt when`` handlers in the order written (Scenic runs the last one
+    written first when several conditions hold)."""
 
     body: tuple[Node, ...]
     handlers: tuple[Interrupt, ...]

@@ -145,8 +145,7 @@ class Explainer:
         obj = min(per_object, key=lambda o: int(per_object[o][start]))
         survived = int(per_object[obj][start])
         position = start + survived
-        steps = self.run(obj, {**assignment}, start, survived + 1) if obj in assignment else []
-        outputs = steps[-1][1] if steps else set()
+        outputs = self.run(obj, assignment, start, survived + 1)[-1][1]
         ids = self.trace.objects.id
         return (
             f"furthest reach with {self._names(assignment)}: the window from {self.frame(start)} "

@@ -60,7 +60,6 @@ class Outcome:
     feasible: bool = True
     best: Node | None = None
     scene_failures: list[tuple[Assignment, np.ndarray]] = field(default_factory=list)
-    explored: int = 0
 
 
 class Search:
@@ -118,7 +117,7 @@ class Search:
             bound = [j for j, a in enumerate(assignments) if all(o in a for o in guard.objects)]
             if bound:
                 block = np.array([[assignments[j][o] for o in guard.objects] for j in bound], dtype=np.int64)
-                value[bound] = self.obs.guard_codes(guard, block.reshape(len(bound), len(guard.objects)))
+                value[bound] = self.obs.guard_codes(guard, block)
             codes.append(value)
         return encode(masks, codes, len(automaton.outputs))
 
@@ -186,7 +185,6 @@ class Search:
 
     def _extend(self, order: list[str], node: Node) -> Iterator[None]:
         out = self.outcome
-        out.explored += 1
         self._note_best(node)
         if len(node.assignment) == len(order):
             out.matches.append((dict(node.assignment), np.flatnonzero(node.alive)))
@@ -215,7 +213,6 @@ class Search:
                     if not self.find_all:
                         return
             else:
-                out.explored += 1
                 self._note_best(child)
 
     def _check_scene(self, node: Node, newest: str) -> None:

@@ -1,6 +1,8 @@
 """The README stays true: its test command is what CI runs; its quick-start main job works."""
 
 import re
+
+import pytest
 from pathlib import Path
 
 from scenegrep.cli.main import main
@@ -27,3 +29,14 @@ def test_quick_start_main_job_runs(monkeypatch):
     monkeypatch.chdir(REPO)
     command = quick_start()[0].split(".venv/bin/scenegrep ", 1)[1]
     assert main(command.split()) == 0
+
+
+@pytest.mark.slow
+@pytest.mark.real_data
+def test_dataset_python_example_runs(real_data, tmp_path, monkeypatch):
+    section = README.split("### Queries over a dataset", 1)[1]
+    code = re.findall(r"```python\n(.+?)\n```", section, re.S)[0]
+    monkeypatch.chdir(REPO)
+    fleet = str(tmp_path / "fleet")
+    exec(code.replace('"fleet"', repr(fleet)).replace('"../shared/real_data"', repr(str(real_data))), {})
+    assert (tmp_path / "fleet" / "catalog.duckdb").is_file()

@@ -19,7 +19,8 @@ import json
 import sys
 from typing import Any
 
-from .scene import add_tolerance_arguments, tolerance_of
+from .dataset_run import add_dataset_arguments, reject_dataset_only, run_dataset
+from .scene import add_tolerance_arguments, tolerance_of, tolerance_options
 
 NO_MATCH = 1
 
@@ -47,6 +48,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--online", action="store_true", help="read trace documents from stdin, frame by frame")
     parser.add_argument("--json", action="store_true", help="print one JSON object per match")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
+    add_dataset_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -105,11 +107,31 @@ def _labelled(trace: Any, road_map: Any, args: argparse.Namespace) -> Any:
     return label_trace(trace, road_map).trace
 
 
+def _run_dataset(args: argparse.Namespace) -> int:
+    from ..errors import UserError
+    from ..scenic.parser import read_program
+
+    if args.online:
+        raise UserError("--online reads stdin; it does not take --dataset")
+    options = {
+        "window": args.window,
+        "visible_distance": args.visible_distance,
+        "vocabulary": args.vocabulary,
+        "all": args.all,
+        "explain": args.explain,
+        **tolerance_options(args),
+    }
+    return run_dataset(args, "scenario", read_program(args.program), args.program, options)
+
+
 def run(args: argparse.Namespace) -> int:
     from .. import readers
     from ..errors import UserError
     from ..scenario import load_scenario, load_vocabulary
 
+    if args.dataset:
+        return _run_dataset(args)
+    reject_dataset_only(args)
     query = load_scenario(args.program, load_vocabulary(args.vocabulary), args.visible_distance)
     options = _options(args)
     road_map = readers.read_map(args.map) if args.map else None
@@ -118,7 +140,7 @@ def run(args: argparse.Namespace) -> int:
             raise UserError("--online reads stdin; give no DATA")
         return _run_online(query, road_map, options, args)
     if not args.data:
-        raise UserError("give DATA (trace files or directories), or --online")
+        raise UserError("give DATA (trace files or directories), --dataset, or --online")
     found = False
     traces = matched = 0
     for path in args.data:

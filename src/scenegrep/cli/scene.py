@@ -15,6 +15,8 @@ import json
 import sys
 from typing import Any
 
+from .dataset_run import add_dataset_arguments, reject_dataset_only, run_dataset
+
 NO_MATCH = 1
 
 
@@ -29,7 +31,7 @@ def add_parser(subparsers: Any) -> None:
         "CommonRoad, Scenic-generated scenes).",
     )
     parser.add_argument("program", metavar="PROGRAM", help="a .scenic file")
-    parser.add_argument("data", nargs="+", metavar="DATA", help="labeled traces (files or recording directories)")
+    parser.add_argument("data", nargs="*", metavar="DATA", help="labeled traces (files or recording directories)")
     add_tolerance_arguments(parser)
     parser.add_argument("--exact", action="store_true", help="every labeled object in view must be matched")
     parser.add_argument(
@@ -40,6 +42,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object per frame")
     parser.add_argument("--parquet", metavar="FILE", help="also write the matches as a Parquet table")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
+    add_dataset_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -60,6 +63,12 @@ def tolerance_of(args: argparse.Namespace) -> Any:
     if args.tolerance_position < 0 or args.tolerance_heading < 0:
         raise UserError("tolerances must not be negative")
     return Tolerance(args.tolerance_position, args.tolerance_heading)
+
+
+def tolerance_options(args: argparse.Namespace) -> dict[str, float]:
+    """The tolerance options as dataset query options (checked)."""
+    tolerance = tolerance_of(args)
+    return {"tolerance_position": tolerance.position, "tolerance_heading": tolerance.heading}
 
 
 def _value_text(values: dict[str, Any]) -> str:
@@ -116,9 +125,23 @@ def _line(record: dict[str, Any], args: argparse.Namespace) -> str:
     return text
 
 
+def _run_dataset(args: argparse.Namespace) -> int:
+    from ..scenic.parser import read_program
+
+    options = {"visible_distance": args.visible_distance, "exact": args.exact, "explain": args.explain}
+    return run_dataset(args, "scene", read_program(args.program), args.program, options | tolerance_options(args))
+
+
 def run(args: argparse.Namespace) -> int:
     from .. import readers
+    from ..errors import UserError
     from ..scene import SceneOptions, load_scene
+
+    if args.dataset:
+        return _run_dataset(args)
+    reject_dataset_only(args)
+    if not args.data:
+        raise UserError("give DATA (trace files or directories) or --dataset")
 
     query = load_scene(args.program, args.visible_distance)
     options = SceneOptions(tolerance_of(args), args.exact, args.visible_distance)

@@ -12,6 +12,8 @@ import json
 import sys
 from typing import Any
 
+from .dataset_run import add_dataset_arguments, reject_dataset_only, run_dataset
+
 NO_MATCH = 1
 
 
@@ -43,6 +45,7 @@ def add_parser(subparsers: Any) -> None:
         choices=["image", "topdown"],
         help="search image boxes or top-down object boxes (default: image if the input has any)",
     )
+    add_dataset_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -96,11 +99,28 @@ def _report(matches: Any, prefix: str, args: argparse.Namespace, options: Any, t
     return found
 
 
+def _run_dataset(args: argparse.Namespace) -> int:
+    from ..errors import UserError
+
+    if args.online or args.export or args.max_count is not None:
+        raise UserError("--online, --export and --max-count read files; with --dataset use the results table")
+    options = {
+        "compat": args.compat == "strem",
+        "space": args.space,
+        "channels": tuple(args.channel) if args.channel else None,
+        "skip": args.skip,
+    }
+    return run_dataset(args, "spre", args.pattern, "<query>", options)
+
+
 def run(args: argparse.Namespace) -> int:
     from .. import readers
     from ..readers.strem_json import iter_documents
     from ..spre import SearchOptions, TraceSearch, compile_query, search_stream
 
+    if args.dataset:
+        return _run_dataset(args)
+    reject_dataset_only(args)
     query = compile_query(args.pattern, compat=args.compat == "strem")
     for warning in query.warnings:
         print(f"scenegrep: warning: {warning}", file=sys.stderr)

@@ -92,6 +92,12 @@ class LabelTrace:
         return len(self.objects)
 
     @property
+    def frame_period(self) -> float:
+        """The frame period in seconds: the median step of the timestamps (0.1 for a one-frame trace)."""
+        steps = np.diff(self.frame_time)
+        return float(np.median(steps)) if len(steps) else 0.1
+
+    @property
     def duration(self) -> float:
         """Seconds from the first to the last frame (0 for fewer than two frames)."""
         return float(self.frame_time[-1] - self.frame_time[0]) if self.n_frames > 1 else 0.0

@@ -28,12 +28,6 @@ from .translate import Guard
 from .vocabulary import Vocabulary
 
 
-def frame_period(trace: LabelTrace) -> float:
-    """The frame period in seconds: the median step of the timestamps (0.1 for a one-frame trace)."""
-    steps = np.diff(trace.frame_time)
-    return float(np.median(steps)) if len(steps) else 0.1
-
-
 class Observations:
     """One trace's inputs and outputs for scenario queries (see the module docstring)."""
 
@@ -60,7 +54,7 @@ class Observations:
 
     @cached_property
     def period(self) -> float:
-        return frame_period(self.trace)
+        return self.trace.frame_period
 
     @cached_property
     def longest_presence(self) -> np.ndarray:

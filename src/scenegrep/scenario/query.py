@@ -30,7 +30,7 @@ from ..scenic.parser import read_program
 from .automaton import Automaton
 from .explain import Explainer
 from .hfsm import Hfsm
-from .observations import Observations, frame_period
+from .observations import Observations
 from .search import Assignment, Outcome, Search
 from .translate import Guard, Translator
 from .vocabulary import Vocabulary, load_vocabulary
@@ -161,7 +161,7 @@ def window_frames(window: int | str, trace: LabelTrace) -> int:
             seconds = float(window[:-1])
         except ValueError:
             raise UserError(f"bad window {window!r}: give frames (50), seconds (5s) or 'all'") from None
-        m = int(round(seconds / frame_period(trace)))
+        m = int(round(seconds / trace.frame_period))
     else:
         try:
             m = int(window)

@@ -1,0 +1,53 @@
+"""``scenegrep ingest SOURCE... --into DATASET``: build or update a dataset.
+
+Every source (a file or recording directory of any supported format, or a directory searched
+for them) becomes scenegrep Parquet traces in ``DATASET/traces`` and rows of the catalog
+``DATASET/catalog.duckdb``; unchanged sources are skipped. Exit codes: 0 every source
+ingested or unchanged, 2 user error, 3 some source failed (each named on stderr; the others
+are ingested).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any
+
+SOME_FAILED = 3
+
+
+def add_parser(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "ingest",
+        help="convert inputs into a dataset: Parquet traces and a DuckDB catalog",
+        description="Convert inputs of any supported format (files, recording directories, or directories holding "
+        "them) into a dataset directory: one Parquet file per trace, the road maps, and a catalog in DuckDB "
+        "(traces, objects per class, per-class counts per frame, behaviour label statistics, sources and "
+        "checksums). Incremental: re-running skips unchanged sources. Traces without behaviour labels are "
+        "labelled (scenegrep label's labeller) unless --no-label.",
+    )
+    parser.add_argument("sources", nargs="+", metavar="SOURCE", help="inputs or directories of inputs")
+    parser.add_argument("--into", required=True, metavar="DATASET", help="the dataset directory (created if needed)")
+    parser.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes (default: all cores)")
+    parser.add_argument("--no-label", action="store_true", help="do not label traces without behaviour labels")
+    parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    from ..dataset.ingest import ingest
+
+    show = not args.quiet and sys.stderr.isatty()
+    with tqdm(unit="source", file=sys.stderr, disable=not show, leave=False) as bar:
+        report = ingest(args.sources, args.into, args.jobs, not args.no_label, on_outcome=lambda _: bar.update())
+    for path, error in report.failed:
+        print(f"scenegrep: error: {error if error.startswith(path) else f'{path}: {error}'}", file=sys.stderr)
+    if not args.quiet:
+        print(
+            f"scenegrep: {report.ingested} sources ingested ({report.traces} traces), {report.unchanged} unchanged, "
+            f"{len(report.failed)} failed; dataset {args.into}",
+            file=sys.stderr,
+        )
+    return SOME_FAILED if report.failed else 0

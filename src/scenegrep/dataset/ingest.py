@@ -1,0 +1,259 @@
+"""``ingest``: turn inputs of any supported format into a dataset directory.
+
+Layout: ``catalog.duckdb`` (:mod:`.catalog`), ``traces/<trace_id>.parquet`` (scenegrep
+Parquet traces), ``maps/<map_id>.parquet`` (their road maps, converted once per map), and
+``runs/`` (query runs). Sources are files or directories the readers recognise; a directory
+that is not itself an input is searched for inputs, in name order.
+
+Ingest is incremental (a source whose SHA-256 is in the catalog is skipped), atomic per
+trace (each Parquet file appears whole, by rename, before the catalog commits the trace;
+a source's traces are committed together) and reports bad sources without stopping.
+Traces without behaviour labels are labelled with ``scenegrep label``'s labeller unless
+``label`` is False, so scenario queries need no labelling later.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .. import readers
+from ..errors import UserError, at
+from ..readers.trace_folder import SKIPPED
+from .catalog import Catalog
+from .execute import run_all
+from .statistics import TraceStatistics
+
+COMMIT_EVERY = 16
+"""Sources committed to the catalog per transaction (each trace is atomic either way)."""
+
+TRACES_DIR = "traces"
+MAPS_DIR = "maps"
+
+
+@dataclass(frozen=True)
+class Source:
+    """An input to ingest: its absolute path and format name."""
+
+    path: str
+    format: str
+
+
+@dataclass(frozen=True)
+class IngestTask:
+    """What a worker needs to ingest one source: it, the dataset root, the checksum the
+    catalog has for it (None if new) and whether to label traces without behaviour labels."""
+
+    source: Source
+    root: str
+    known_checksum: str | None
+    label: bool
+
+
+@dataclass
+class SourceOutcome:
+    """What became of one source: ``status`` 'ingested', 'unchanged' or 'failed', its checksum,
+    the trace and map rows written (with their statistics), or the error."""
+
+    source: Source
+    status: str
+    checksum: str = ""
+    replaces: bool = False
+    """Whether the catalog had an older version of the source."""
+    traces: list[tuple[dict[str, Any], TraceStatistics]] = field(default_factory=list)
+    maps: list[dict[str, Any]] = field(default_factory=list)
+    error: str = ""
+
+
+@dataclass
+class IngestReport:
+    """Counts of an ingest run and the failed sources (path, one-line error)."""
+
+    ingested: int = 0
+    unchanged: int = 0
+    traces: int = 0
+    failed: list[tuple[str, str]] = field(default_factory=list)
+
+
+def discover(paths: list[str]) -> tuple[list[Source], list[tuple[str, str]]]:
+    """The sources under ``paths`` and the given paths that are not inputs (path, error).
+
+    Directories that are not inputs are searched recursively; files found there that are not
+    trace inputs (READMEs, manifests, map-only files) are skipped silently, and so are JSON files
+    that are not scenegrep traces, as in a trace folder (give STREM streams by name)."""
+    sources: list[Source] = []
+    errors: list[tuple[str, str]] = []
+    for path in paths:
+        try:
+            sources.extend(_sources_in(Path(path), explicit=True))
+        except UserError as exc:
+            errors.append((str(Path(path).resolve()), exc.one_line()))
+    unique = {s.path: s for s in sources}
+    return list(unique.values()), errors
+
+
+def _sources_in(path: Path, explicit: bool) -> Iterator[Source]:
+    if path.is_dir():
+        found = _directory_format(path)
+        if found is not None:
+            yield Source(str(path.resolve()), found)
+            return
+        for child in sorted(path.iterdir()):
+            if not child.name.startswith("."):
+                yield from _sources_in(child, explicit=False)
+        return
+    if explicit:
+        name = readers.detect_format(path)
+        if not readers.FORMATS[name].traces:
+            raise UserError(f"a {readers.FORMATS[name].description} holds no label trace", at(path))
+        yield Source(str(path.resolve()), name)
+        return
+    name = readers.sniff_file(path)
+    if name is not None and name not in SKIPPED and readers.FORMATS[name].traces:
+        yield Source(str(path.resolve()), name)
+
+
+def _directory_format(path: Path) -> str | None:
+    """The format of a directory that is one input (an Argoverse 2 log or scenario), else None."""
+    try:
+        name = readers.detect_format(path)
+    except UserError:
+        return None
+    return None if name == "trace-folder" else name
+
+
+def checksum(path: str) -> str:
+    """SHA-256 of a file's bytes, or of a directory's relative file names and bytes in name order."""
+    root = Path(path)
+    digest = hashlib.sha256()
+    files = [root] if root.is_file() else sorted(p for p in root.rglob("*") if p.is_file())
+    for file in files:
+        if file != root:
+            digest.update(str(file.relative_to(root)).encode() + b"\0")
+        with open(file, "rb") as handle:
+            digest.update(hashlib.file_digest(handle, "sha256").digest())
+    return digest.hexdigest()
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)[:64] or "trace"
+
+
+def trace_id_of(source_path: str, name: str, number: int) -> str:
+    """A trace's id: its name made file-safe, and a hash of its source path and position."""
+    tag = hashlib.sha256(f"{source_path}\0{number}\0{name}".encode()).hexdigest()[:10]
+    return f"{_slug(name)}-{tag}"
+
+
+def map_id_of(map_source: Any) -> str:
+    """A road map's id: a hash of where it is read from."""
+    return hashlib.sha256(repr((map_source.path, map_source.format, map_source.key)).encode()).hexdigest()[:16]
+
+
+def ingest_source(task: IngestTask) -> SourceOutcome:
+    """Ingest one source (runs in a worker): skip it if unchanged, else write its traces and
+    maps and compute their statistics. Any failure becomes a 'failed' outcome."""
+    source = task.source
+    try:
+        digest = checksum(source.path)
+        if digest == task.known_checksum:
+            return SourceOutcome(source, "unchanged", digest)
+        outcome = SourceOutcome(source, "ingested", digest, replaces=task.known_checksum is not None)
+        for number, trace in enumerate(readers.read_traces(source.path, source.format)):
+            outcome.traces.append(_write_trace(trace, number, task, outcome.maps))
+        return outcome
+    except UserError as exc:
+        return SourceOutcome(source, "failed", error=exc.one_line())
+    except Exception as exc:  # a reader's bug must not stop the other sources
+        return SourceOutcome(source, "failed", error=f"{source.path}: {type(exc).__name__}: {exc}")
+
+
+def _write_trace(trace: Any, number: int, task: IngestTask, maps: list[dict[str, Any]]) -> tuple[dict, Any]:
+    from ..writers.trace_parquet import write_map_parquet, write_trace_parquet
+
+    root = Path(task.root)
+    map_id = road_map = None
+    if trace.map_source is not None:
+        map_id = map_id_of(trace.map_source)
+        map_file = f"{MAPS_DIR}/{map_id}.parquet"
+        road_map = readers.read_map(trace.map_source)
+        if not (root / map_file).is_file():
+            write_map_parquet(road_map, root / map_file)
+        ms = trace.map_source
+        maps.append({"map_id": map_id, "file": map_file, "source_path": ms.path, "format": ms.format, "key": ms.key})
+    if task.label and trace.behaviours is None:
+        from ..label import label_trace
+
+        trace = label_trace(trace, road_map).trace
+    trace_id = trace_id_of(task.source.path, trace.name, number)
+    file = f"{TRACES_DIR}/{trace_id}.parquet"
+    write_trace_parquet(trace, root / file)
+    stats = TraceStatistics.of(trace)
+    row = {"trace_id": trace_id, **stats.trace, "source_path": task.source.path, "file": file, "map_id": map_id}
+    return row, stats
+
+
+def _remove_stale_temporaries(root: Path) -> None:
+    """Delete the temporary files a killed ingest left (atomic writes never expose them)."""
+    for folder in (root / TRACES_DIR, root / MAPS_DIR):
+        if folder.is_dir():
+            for tmp in folder.glob(".*.tmp"):
+                tmp.unlink(missing_ok=True)
+
+
+def ingest(
+    paths: list[str],
+    into: str | Path,
+    jobs: int | None = None,
+    label: bool = True,
+    on_outcome: Callable[[SourceOutcome], None] | None = None,
+) -> IngestReport:
+    """Ingest every source under ``paths`` into the dataset ``into`` (created if needed) with
+    ``jobs`` local workers; ``on_outcome`` sees each source's outcome as it is committed."""
+    root = Path(into).resolve()
+    sources, bad = discover(paths)
+    with Catalog(root, create=True) as catalog:
+        known = catalog.checksums()
+        for path, error in bad:
+            catalog.record_source_error(path, error)
+    _remove_stale_temporaries(root)
+    tasks = [IngestTask(s, str(root), known.get(s.path), label) for s in sources]
+    report = IngestReport(failed=list(bad))
+    results = run_all(ingest_source, tasks, jobs)
+    batch: list[SourceOutcome] = []
+    with Catalog(root) as catalog:
+        for _, outcome in results:
+            batch.append(outcome)
+            if len(batch) >= COMMIT_EVERY:
+                _commit(catalog, root, batch, report)
+                batch = []
+            if on_outcome is not None:
+                on_outcome(outcome)
+        _commit(catalog, root, batch, report)
+    return report
+
+
+def _commit(catalog: Catalog, root: Path, batch: list[SourceOutcome], report: IngestReport) -> None:
+    """Record a batch of outcomes in one transaction; then delete trace files no trace uses."""
+    ingested = [o for o in batch if o.status == "ingested"]
+    report.unchanged += sum(o.status == "unchanged" for o in batch)
+    for outcome in batch:
+        if outcome.status == "failed":
+            catalog.record_source_error(outcome.source.path, outcome.error)
+            report.failed.append((outcome.source.path, outcome.error))
+    maps = {row["map_id"]: row for o in ingested for row in o.maps}
+    for row in maps.values():
+        catalog.add_map(row)
+    old_files = {f for o in ingested if o.replaces for f in catalog.trace_files(o.source.path)}
+    catalog.replace_sources(
+        [({"path": o.source.path, "format": o.source.format, "checksum": o.checksum}, o.traces) for o in ingested]
+    )
+    for stale in old_files - {row["file"] for o in ingested for row, _ in o.traces}:
+        os.unlink(root / stale)
+    report.ingested += len(ingested)
+    report.traces += sum(len(o.traces) for o in ingested)

@@ -1,0 +1,252 @@
+"""The three query kinds as the dataset engine sees them: a picklable :class:`QuerySpec`,
+compiled once per process, applied to one trace to give rows of the results table.
+
+Results table (one row per match; a trace without a match has one row with ``match`` -1):
+``trace_id``, ``name`` (the trace's name), ``source`` (the ingested input), ``status``
+('match', 'no match', 'pruned' or 'failed'), ``match`` (0, 1, ... within the trace),
+``correspondence`` (JSON object: program object -> trace object id; for SpRE, the track
+binders' variables), ``start_frame``/``end_frame`` (dataset frame indices of the window's first
+and last frame, inclusive), ``start_time``/``end_time`` (seconds from the trace's start),
+``time_origin_ns`` (the trace's absolute time 0), ``explanation`` (with ``explain``: the
+witness of a match or why the trace does not match; for pruned traces, why), ``error``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+
+from ..errors import UserError, at
+from ..model import LabelTrace, RoadMap
+
+KINDS = ("scenario", "scene", "spre")
+
+RESULTS_SCHEMA = pa.schema(
+    [
+        ("trace_id", pa.string()),
+        ("name", pa.string()),
+        ("source", pa.string()),
+        ("status", pa.string()),
+        ("match", pa.int32()),
+        ("correspondence", pa.string()),
+        ("start_frame", pa.int64()),
+        ("end_frame", pa.int64()),
+        ("start_time", pa.float64()),
+        ("end_time", pa.float64()),
+        ("time_origin_ns", pa.int64()),
+        ("explanation", pa.string()),
+        ("error", pa.string()),
+    ]
+)
+
+OPTIONS: dict[str, dict[str, Any]] = {
+    "scenario": {
+        "window": None,
+        "tolerance_position": 1e-6,
+        "tolerance_heading": 1e-6,
+        "visible_distance": None,
+        "vocabulary": None,
+        "all": False,
+        "explain": False,
+    },
+    "scene": {
+        "tolerance_position": 1e-6,
+        "tolerance_heading": 1e-6,
+        "visible_distance": None,
+        "exact": False,
+        "explain": False,
+    },
+    "spre": {"compat": False, "space": None, "channels": None, "skip": 0},
+}
+"""Each kind's options and their defaults (the command-line options of the same names)."""
+
+
+@dataclass(frozen=True)
+class QuerySpec:
+    """A query as data: its ``kind``, its ``text`` (a Scenic program or a SpRE), the ``origin``
+    its errors name (a file name) and its options as sorted (name, value) pairs."""
+
+    kind: str
+    text: str
+    origin: str
+    options: tuple[tuple[str, Any], ...]
+
+    @classmethod
+    def of(cls, kind: str, text: str, origin: str = "<query>", **options: Any) -> QuerySpec:
+        """A spec with ``options`` checked against the kind's and completed with defaults."""
+        if kind not in KINDS:
+            raise UserError(f"unknown query kind {kind!r}; choose one of {', '.join(KINDS)}")
+        unknown = set(options) - set(OPTIONS[kind])
+        if unknown:
+            raise UserError(f"{kind} queries have no option {sorted(unknown)[0]!r}")
+        merged = OPTIONS[kind] | {k: _plain(v) for k, v in options.items()}
+        if kind == "scenario" and merged["window"] is None:
+            raise UserError("scenario queries need a window (frames, seconds such as '5s', or 'all')")
+        return cls(kind, text, origin, tuple(sorted(merged.items())))
+
+    @classmethod
+    def from_file(cls, kind: str, path: str | Path, **options: Any) -> QuerySpec:
+        """A spec whose text is a Scenic program file."""
+        from ..scenic.parser import read_program
+
+        return cls.of(kind, read_program(path), str(path), **options)
+
+    def option(self, name: str) -> Any:
+        return dict(self.options)[name]
+
+    def key(self) -> str:
+        """A canonical JSON text of the spec (a run's identity)."""
+        return json.dumps([self.kind, self.text, dict(self.options)], sort_keys=True)
+
+
+def _plain(value: Any) -> Any:
+    """Options as JSON-able, hashable values (lists become tuples)."""
+    return tuple(value) if isinstance(value, list) else value
+
+
+_COMPILED: dict[QuerySpec, Any] = {}
+
+
+def compiled(spec: QuerySpec) -> Any:
+    """The compiled query of a spec, compiled once per process (UserError if it does not compile)."""
+    if spec not in _COMPILED:
+        _COMPILED[spec] = _compile(spec)
+    return _COMPILED[spec]
+
+
+def _compile(spec: QuerySpec) -> Any:
+    if spec.kind == "spre":
+        from ..spre import compile_query
+
+        return compile_query(spec.text, compat=spec.option("compat"), source=spec.origin)
+    if spec.kind == "scene":
+        from ..scene import compile_scene
+
+        return compile_scene(spec.text, spec.origin, spec.option("visible_distance"))
+    from ..scenario import compile_scenario, load_vocabulary
+
+    vocabulary = load_vocabulary(spec.option("vocabulary"))
+    return compile_scenario(spec.text, spec.origin, vocabulary, spec.option("visible_distance"))
+
+
+def _tolerance(spec: QuerySpec) -> Any:
+    from ..scene import Tolerance
+
+    position, heading = spec.option("tolerance_position"), spec.option("tolerance_heading")
+    if position < 0 or heading < 0:
+        raise UserError("tolerances must not be negative")
+    return Tolerance(position, heading)
+
+
+def match_trace(spec: QuerySpec, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
+    """The result rows of one trace (without its trace_id, name, source and time origin), at
+    least one: a trace without a match gives one 'no match' row."""
+    runner = {"spre": _spre_rows, "scene": _scene_rows, "scenario": _scenario_rows}[spec.kind]
+    rows = runner(spec, compiled(spec), trace, road_map)
+    return rows or [{"status": "no match", "match": -1}]
+
+
+def _window(trace: LabelTrace, match: int, first: int, last: int, correspondence: Any) -> dict[str, Any]:
+    return {
+        "status": "match",
+        "match": match,
+        "correspondence": json.dumps(correspondence or {}, sort_keys=True),
+        "start_frame": int(trace.frame_index[first]),
+        "end_frame": int(trace.frame_index[last]),
+        "start_time": float(trace.frame_time[first]),
+        "end_time": float(trace.frame_time[last]),
+    }
+
+
+def _spre_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
+    from ..spre import SearchOptions, TraceSearch
+
+    options = SearchOptions(spec.option("space"), spec.option("channels"), max(spec.option("skip"), 0))
+    search = TraceSearch(query, trace, options)
+    searched = search.trace
+    rows = []
+    for number, match in enumerate(search.offline()):
+        row = _window(searched, number, match.start, match.end - 1, match.bound)
+        rows.append(row)
+    return rows
+
+
+def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
+    from ..scene import SceneOptions
+
+    options = SceneOptions(_tolerance(spec), spec.option("exact"), spec.option("visible_distance"))
+    result = query.match(trace, road_map, options)
+    rows = [
+        _window(trace, number, frame, frame, result.correspondence(frame))
+        for number, frame in enumerate(result.frames().tolist())
+    ]
+    if not rows and spec.option("explain"):
+        failures = (f"frame {int(trace.frame_index[f])}: {result.failure(f)}" for f in range(trace.n_frames))
+        return [{"status": "no match", "match": -1, "explanation": "\n".join(failures)}]
+    return rows
+
+
+def _scenario_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
+    from ..scenario import ScenarioOptions
+
+    if trace.behaviours is None:
+        from ..label import label_trace
+
+        trace = label_trace(trace, road_map).trace
+    find_all, explain = spec.option("all"), spec.option("explain")
+    options = ScenarioOptions(_tolerance(spec), spec.option("visible_distance"), find_all)
+    result = query.match(trace, spec.option("window"), road_map, options)
+    rows = []
+    for number, (match, first, last) in enumerate(result.windows()):
+        row = _window(trace, number, first, last, match.correspondence)
+        if explain:
+            row["explanation"] = "\n".join(result.explain(result.matches.index(match), first))
+        rows.append(row)
+        if not find_all:
+            break
+    if not rows and explain:
+        return [{"status": "no match", "match": -1, "explanation": result.why_not()}]
+    return rows
+
+
+@dataclass(frozen=True)
+class TraceTask:
+    """One trace to query: its catalog identity, its Parquet file and its map's (absolute paths)."""
+
+    trace_id: str
+    name: str
+    source: str
+    file: str
+    map_file: str | None
+    time_origin_ns: int
+
+
+def run_tasks(work: tuple[QuerySpec, str | None, list[TraceTask]]) -> list[dict[str, Any]]:
+    """Query a chunk of traces (runs in a worker): ``work`` is the spec, a fallback map path for
+    traces without one, and the tasks. A trace that fails to load or query gives a 'failed' row."""
+    from .. import readers
+
+    spec, fallback_map, tasks = work
+    rows = []
+    for task in tasks:
+        identity = {"trace_id": task.trace_id, "name": task.name, "source": task.source}
+        try:
+            trace = readers.read_trace(task.file, "scenegrep-parquet")
+            map_path = task.map_file or fallback_map
+            road_map = readers.read_map(map_path) if map_path else None
+            found = match_trace(spec, trace, road_map)
+        except UserError as exc:
+            found = [{"status": "failed", "match": -1, "error": exc.one_line()}]
+        except Exception as exc:  # one broken trace must not stop the run
+            found = [{"status": "failed", "match": -1, "error": f"{at(task.file)}: {type(exc).__name__}: {exc}"}]
+        rows.extend({**identity, "time_origin_ns": task.time_origin_ns, **row} for row in found)
+    return rows
+
+
+def results_table(rows: list[dict[str, Any]]) -> pa.Table:
+    """Rows (dicts with some of the columns) as a table of :data:`RESULTS_SCHEMA`."""
+    return pa.Table.from_pylist(rows, schema=RESULTS_SCHEMA)

@@ -1,0 +1,151 @@
+"""A query run over a dataset: plan, query the kept traces in parallel, keep the results.
+
+A run's identity is a hash of its query and options (``run_id``). Its directory
+``runs/<run_id>/`` holds ``query.json``, ``parts/`` (one Parquet file per finished chunk of
+traces, each written atomically as the chunk completes) and, at the end, ``results.parquet``;
+the same table goes into the catalog's ``results`` table (``WHERE run_id = ...``). A run
+stopped by Ctrl-C keeps what is done (status 'interrupted'); one killed outright keeps its
+parts. ``resume`` reuses the parts of a previous run of the same query and queries only the
+traces without one, so the final results equal those of an uninterrupted run.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import shutil
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from .catalog import Catalog
+from .execute import default_jobs, run_all
+from .plan import Plan, needs_of, plan
+from .queries import QuerySpec, TraceTask, compiled, results_table, run_tasks
+from .results import Results
+
+MAX_CHUNK = 64
+"""At most this many traces per task: results are saved (and progress shown) per chunk."""
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How to run: ``jobs`` workers (None: all cores), ``engine`` 'local' or 'ray' (with a
+    cluster ``address``; None starts a local instance), ``resume`` a previous run, a fallback
+    road map ``map_path`` for traces without one, and whether to show a ``progress`` bar."""
+
+    jobs: int | None = None
+    engine: str = "local"
+    address: str | None = None
+    resume: bool = False
+    map_path: str | None = None
+    progress: bool = False
+
+
+def run_id_of(spec: QuerySpec) -> str:
+    return hashlib.sha256(spec.key().encode()).hexdigest()[:12]
+
+
+def run_query(
+    root: Path, spec: QuerySpec, options: RunOptions, on_plan: Callable[[Plan], None] | None = None
+) -> Results:
+    """Run ``spec`` over the dataset at ``root``; see the module docstring. ``on_plan`` sees the
+    plan before any trace is queried."""
+    query = compiled(spec)
+    run_id = run_id_of(spec)
+    folder = root / "runs" / run_id
+    with Catalog(root) as catalog:
+        planned = plan(catalog, needs_of(spec, query))
+        maps = dict(catalog.rows("SELECT map_id, file FROM maps"))
+        catalog.start_run(run_id, spec.kind, spec.text, json.dumps(dict(spec.options)))
+    if on_plan is not None:
+        on_plan(planned)
+    parts = folder / "parts"
+    if not options.resume and folder.exists():
+        shutil.rmtree(folder)
+    parts.mkdir(parents=True, exist_ok=True)
+    (folder / "query.json").write_text(spec.key())
+    done = _finished_traces(parts)
+    todo = [_task(root, row, maps) for row in planned.kept if row["trace_id"] not in done]
+    status = _execute(spec, todo, parts, options, len(planned.kept), len(done))
+    return _finish(root, run_id, status, parts, planned)
+
+
+def _task(root: Path, row: dict[str, Any], maps: dict[str, str]) -> TraceTask:
+    map_file = maps.get(row["map_id"]) if row["map_id"] else None
+    return TraceTask(
+        row["trace_id"],
+        row["name"],
+        row["source_path"],
+        str(root / row["file"]),
+        None if map_file is None else str(root / map_file),
+        row["time_origin_ns"],
+    )
+
+
+def _finished_traces(parts: Path) -> set[str]:
+    done: set[str] = set()
+    for part in parts.glob("*.parquet"):
+        done.update(pq.read_table(part, columns=["trace_id"])["trace_id"].to_pylist())
+    return done
+
+
+def _chunks(tasks: list[TraceTask], workers: int) -> list[list[TraceTask]]:
+    size = max(1, min(MAX_CHUNK, math.ceil(len(tasks) / (workers * 16))))
+    return [tasks[i : i + size] for i in range(0, len(tasks), size)]
+
+
+def _execute(spec: QuerySpec, todo: list[TraceTask], parts: Path, options: RunOptions, total: int, done: int) -> str:
+    """Query the traces, saving each chunk's rows as a part; 'finished' or 'interrupted'."""
+    from tqdm import tqdm
+
+    from ..writers.atomic import atomic_path
+
+    chunks = _chunks(todo, options.jobs or default_jobs())
+    work = [(spec, options.map_path, chunk) for chunk in chunks]
+    bar = tqdm(total=total, initial=done, unit="trace", file=sys.stderr, disable=not options.progress, leave=False)
+    matched = 0
+    try:
+        for number, rows in run_all(run_tasks, work, options.jobs, options.engine, options.address):
+            name = hashlib.sha256("\0".join(t.trace_id for t in chunks[number]).encode()).hexdigest()[:16]
+            with atomic_path(parts / f"{name}.parquet") as tmp:
+                pq.write_table(results_table(rows), tmp)
+            matched += len({r["trace_id"] for r in rows if r["status"] == "match"})
+            bar.set_postfix_str(f"{matched} matched", refresh=False)
+            bar.update(len(chunks[number]))
+    except KeyboardInterrupt:
+        return "interrupted"
+    finally:
+        bar.close()
+    return "finished"
+
+
+def _finish(root: Path, run_id: str, status: str, parts: Path, planned: Plan) -> Results:
+    """Gather the parts and the pruned traces into the results; write them out and to the catalog."""
+    tables = [pq.read_table(p) for p in sorted(parts.glob("*.parquet"))]
+    pruned = [
+        {
+            "trace_id": row["trace_id"],
+            "name": row["name"],
+            "source": row["source_path"],
+            "status": "pruned",
+            "match": -1,
+            "time_origin_ns": row["time_origin_ns"],
+            "explanation": reason,
+        }
+        for row, reason in planned.pruned
+    ]
+    table = pa.concat_tables([results_table(pruned), *tables]).sort_by(
+        [("trace_id", "ascending"), ("match", "ascending")]
+    )
+    results = Results(table, run_id, status)
+    results.write_parquet(root / "runs" / run_id / "results.parquet")
+    with Catalog(root) as catalog:
+        catalog.finish_run(run_id, status, table, results.counts())
+    return results

@@ -250,3 +250,39 @@ def test_user_errors_are_one_line(tmp_path: Path):
     assert result.stderr.count("\n") == 1 and "not a scenegrep dataset" in result.stderr
     result = subprocess.run(cli("spre", "[[:car:]]", "x.json", "--resume"), capture_output=True, text=True)
     assert result.returncode == 2 and "--resume needs --dataset" in result.stderr
+
+
+def test_window_in_seconds_prunes_and_matches_as_frames(real_dataset: Path):
+    frames = run_query(real_dataset, specs()["scenario"], RunOptions(jobs=2)).to_arrow()
+    seconds = run_query(real_dataset, QuerySpec.from_file("scenario", SCENARIO, window="7.5s"), RunOptions(jobs=2))
+    assert seconds.to_arrow().drop_columns(["explanation"]).equals(frames.drop_columns(["explanation"]))
+    assert seconds.counts()["pruned"] == 15
+
+
+@pytest.mark.slow
+def test_progress_bar_on_a_terminal_only(real_dataset: Path, tmp_path: Path):
+    import fcntl
+    import os
+    import pty
+    import struct
+    import termios
+
+    root = copy_of(real_dataset, tmp_path)
+    leader, follower = pty.openpty()
+    fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 120, 0, 0))  # a terminal's size
+    process = subprocess.Popen(scenario_command(root), stdout=subprocess.DEVNULL, stderr=follower)
+    os.close(follower)
+    shown = b""
+    while True:
+        try:
+            chunk = os.read(leader, 4096)
+        except OSError:
+            break
+        if not chunk:
+            break
+        shown += chunk
+    process.wait()
+    text = shown.decode(errors="replace")
+    assert "trace/s" in text and "matched" in text and "/47" in text
+    piped = subprocess.run(scenario_command(root), capture_output=True, text=True)
+    assert "trace/s" not in piped.stderr

@@ -105,7 +105,11 @@ def _ray(
             options["num_cpus"] = jobs
         else:
             options["address"] = address
-        ray.init(**options)
+        try:
+            ray.init(**options)
+        except (ConnectionError, RuntimeError, ValueError) as exc:
+            where = f"at {address}" if address else "locally"
+            raise UserError(f"cannot start Ray {where}: {str(exc).splitlines()[0]}") from None
     remote = ray.remote(function)
     pending: dict[Any, int] = {}
     try:

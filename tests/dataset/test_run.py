@@ -17,6 +17,7 @@ from scenegrep import readers
 from scenegrep.dataset import QuerySpec, RunOptions, open_dataset
 from scenegrep.dataset.catalog import Catalog
 from scenegrep.dataset.run import run_query
+from scenegrep.errors import UserError
 from scenegrep.label import label_trace
 from scenegrep.scenario import ScenarioOptions, load_scenario
 from scenegrep.scene import SceneOptions, Tolerance, load_scene
@@ -250,6 +251,8 @@ def test_user_errors_are_one_line(tmp_path: Path):
     assert result.stderr.count("\n") == 1 and "not a scenegrep dataset" in result.stderr
     result = subprocess.run(cli("spre", "[[:car:]]", "x.json", "--resume"), capture_output=True, text=True)
     assert result.returncode == 2 and "--resume needs --dataset" in result.stderr
+    with pytest.raises(UserError, match="tolerances must not be negative"):
+        QuerySpec.from_file("scene", SCENE, tolerance_position=-0.1)
 
 
 def test_window_in_seconds_prunes_and_matches_as_frames(real_dataset: Path):

@@ -16,9 +16,9 @@ import sys
 from collections import Counter
 from typing import Any
 
+from .main import EXIT_INTERRUPTED, EXIT_SOME_FAILED
+
 NO_MATCH = 1
-SOME_FAILED = 3
-INTERRUPTED = 130
 
 
 def add_dataset_arguments(parser: argparse.ArgumentParser) -> None:
@@ -67,9 +67,9 @@ def run_dataset(args: argparse.Namespace, kind: str, query: str, origin: str, op
         _summary(results, Path(args.dataset))
     counts = results.counts()
     if results.status == "interrupted":
-        return INTERRUPTED
+        return EXIT_INTERRUPTED
     if counts["failed"]:
-        return SOME_FAILED
+        return EXIT_SOME_FAILED
     return 0 if counts["matched"] else NO_MATCH
 
 

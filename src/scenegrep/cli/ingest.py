@@ -13,7 +13,7 @@ import argparse
 import sys
 from typing import Any
 
-SOME_FAILED = 3
+from .main import EXIT_SOME_FAILED
 
 
 def add_parser(subparsers: Any) -> None:
@@ -50,4 +50,4 @@ def run(args: argparse.Namespace) -> int:
             f"{len(report.failed)} failed; dataset {args.into}",
             file=sys.stderr,
         )
-    return SOME_FAILED if report.failed else 0
+    return EXIT_SOME_FAILED if report.failed else 0

@@ -1,7 +1,8 @@
 """``scenegrep``: the entry point. Parses the command, runs it, maps errors to exit codes.
 
 Exit codes: 0 success (for queries: some match), 1 no match, 2 user error
-(printed as one line ``scenegrep: error: PLACE: MESSAGE``), 130 interrupted.
+(printed as one line ``scenegrep: error: PLACE: MESSAGE``), 3 some source or trace
+failed while the others were done, 130 interrupted.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ COMMANDS = ("export", "info", "ingest", "label", "scenario", "scene", "spre", "s
 """Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
 
 EXIT_USER_ERROR = 2
+EXIT_SOME_FAILED = 3
 EXIT_INTERRUPTED = 130
 
 

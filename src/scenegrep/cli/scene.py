@@ -57,12 +57,9 @@ def add_tolerance_arguments(parser: argparse.ArgumentParser) -> None:
 
 def tolerance_of(args: argparse.Namespace) -> Any:
     """The :class:`~scenegrep.scene.Tolerance` the options give (negative values are user errors)."""
-    from ..errors import UserError
     from ..scene import Tolerance
 
-    if args.tolerance_position < 0 or args.tolerance_heading < 0:
-        raise UserError("tolerances must not be negative")
-    return Tolerance(args.tolerance_position, args.tolerance_heading)
+    return Tolerance.checked(args.tolerance_position, args.tolerance_heading)
 
 
 def tolerance_options(args: argparse.Namespace) -> dict[str, float]:

@@ -86,7 +86,10 @@ class QuerySpec:
         merged = OPTIONS[kind] | {k: _plain(v) for k, v in options.items()}
         if kind == "scenario" and merged["window"] is None:
             raise UserError("scenario queries need a window (frames, seconds such as '5s', or 'all')")
-        return cls(kind, text, origin, tuple(sorted(merged.items())))
+        spec = cls(kind, text, origin, tuple(sorted(merged.items())))
+        if kind != "spre":
+            _tolerance(spec)
+        return spec
 
     @classmethod
     def from_file(cls, kind: str, path: str | Path, **options: Any) -> QuerySpec:
@@ -134,12 +137,10 @@ def _compile(spec: QuerySpec) -> Any:
 
 
 def _tolerance(spec: QuerySpec) -> Any:
+    """The spec's tolerances (checked when the spec was made)."""
     from ..scene import Tolerance
 
-    position, heading = spec.option("tolerance_position"), spec.option("tolerance_heading")
-    if position < 0 or heading < 0:
-        raise UserError("tolerances must not be negative")
-    return Tolerance(position, heading)
+    return Tolerance.checked(spec.option("tolerance_position"), spec.option("tolerance_heading"))
 
 
 def match_trace(spec: QuerySpec, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import UserError
 from .dependencies import Group
 from .evaluate import Affine, Evaluator, NotAffine
 from .program import Feature
@@ -39,6 +40,13 @@ class Tolerance:
 
     def of(self, feature: Feature) -> float:
         return self.heading if feature.is_angle else self.position
+
+    @classmethod
+    def checked(cls, position: float, heading: float) -> Tolerance:
+        """Tolerances a user gave (UserError if either is negative)."""
+        if position < 0 or heading < 0:
+            raise UserError("tolerances must not be negative")
+        return cls(position, heading)
 
 
 @dataclass

@@ -53,3 +53,15 @@ def scenic_cache(tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("SCENEGREP_CACHE", str(folder))
         yield folder
+
+
+@pytest.fixture(scope="session")
+def real_dataset(real_data: Path, tmp_path_factory) -> Path:
+    """../shared/real_data and examples/sample ingested with two workers, once per test process
+    (do not modify it: tests that change a dataset copy it first)."""
+    from scenegrep.dataset.ingest import ingest
+
+    root = tmp_path_factory.mktemp("dataset") / "fleet"
+    report = ingest([str(real_data), str(REPO / "examples" / "sample")], root, jobs=2)
+    assert not report.failed, report.failed
+    return root

@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from .. import __version__  # noqa: E402
 from ..errors import UserError  # noqa: E402
 
-COMMANDS = ("export", "info", "ingest", "label", "scenario", "scene", "spre", "synth")
+COMMANDS = ("export", "info", "ingest", "label", "report", "scenario", "scene", "serve", "show", "spre", "synth")
 """Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
 
 EXIT_USER_ERROR = 2

@@ -15,6 +15,10 @@ import pyarrow.parquet as pq
 from ..errors import UserError, at
 from .queries import RESULTS_SCHEMA
 
+RUN_ID_KEY = b"scenegrep.run_id"
+STATUS_KEY = b"scenegrep.status"
+"""Keys of the run's id and status in a results Parquet file's metadata."""
+
 
 @dataclass(frozen=True)
 class Results:
@@ -27,15 +31,25 @@ class Results:
 
     @classmethod
     def read(cls, path: str | Path) -> Results:
-        """Results from a Parquet file written by a run (UserError if it is not one)."""
+        """Results from a file a run wrote: Parquet, JSON lines (``.json``, ``.jsonl``) or CSV
+        (UserError if it is not a results table)."""
+        suffix = Path(path).suffix.lower()
         try:
-            table = pq.read_table(path)
-        except (OSError, pa.ArrowInvalid) as exc:
+            if suffix in (".json", ".jsonl"):
+                table = _from_rows(_json_rows(path))
+            elif suffix == ".csv":
+                table = _from_rows(_csv_rows(path))
+            else:
+                table = pq.read_table(path)
+        except (OSError, ValueError, pa.ArrowException) as exc:
             raise UserError(f"cannot read results: {str(exc).splitlines()[0]}", at(path)) from None
         missing = set(RESULTS_SCHEMA.names) - set(table.column_names)
         if missing:
             raise UserError(f"not a scenegrep results table (no column {sorted(missing)[0]!r})", at(path))
-        return cls(table.select(RESULTS_SCHEMA.names).cast(RESULTS_SCHEMA))
+        metadata = table.schema.metadata or {}
+        run_id = metadata.get(RUN_ID_KEY, b"").decode()
+        status = metadata.get(STATUS_KEY, b"finished").decode()
+        return cls(table.select(RESULTS_SCHEMA.names).cast(RESULTS_SCHEMA), run_id, status)
 
     def __len__(self) -> int:
         return self.table.num_rows
@@ -94,4 +108,37 @@ class Results:
         from ..writers.atomic import atomic_path
 
         with atomic_path(path) as tmp:
-            pq.write_table(self.table, tmp, compression="zstd")
+            metadata = {RUN_ID_KEY: self.run_id.encode(), STATUS_KEY: self.status.encode()}
+            pq.write_table(self.table.replace_schema_metadata(metadata), tmp, compression="zstd")
+
+
+def _json_rows(path: str | Path) -> list[dict[str, Any]]:
+    """The rows of a JSON-lines results file (as ``write_json`` writes them)."""
+    with open(path, encoding="utf-8") as stream:
+        rows = [json.loads(line) for line in stream if line.strip()]
+    for row in rows:
+        if isinstance(row.get("correspondence"), dict):
+            row["correspondence"] = json.dumps(row["correspondence"], sort_keys=True)
+    return rows
+
+
+def _csv_rows(path: str | Path) -> list[dict[str, Any]]:
+    """The rows of a CSV results file (empty cells are nulls)."""
+    with open(path, encoding="utf-8", newline="") as stream:
+        return [{k: (v if v != "" else None) for k, v in row.items()} for row in csv.DictReader(stream)]
+
+
+def _text(value: Any) -> str | None:
+    return None if value is None else str(value)
+
+
+def _from_rows(rows: list[dict[str, Any]]) -> pa.Table:
+    """Rows of text or JSON values as a table of the results' types."""
+    if rows and not set(RESULTS_SCHEMA.names) <= set(rows[0]):
+        missing = sorted(set(RESULTS_SCHEMA.names) - set(rows[0]))
+        raise ValueError(f"not a scenegrep results table (no column {missing[0]!r})")
+    columns = {
+        field.name: pa.array([_text(row.get(field.name)) for row in rows], pa.string()).cast(field.type)
+        for field in RESULTS_SCHEMA
+    }
+    return pa.table(columns, schema=RESULTS_SCHEMA)

@@ -40,13 +40,7 @@ class CompiledQuery:
 
     @property
     def has_track_binders(self) -> bool:
-        return any(isinstance(node, s.TrackBinder) for node in _nodes(self.tree))
-
-
-def _nodes(node: s.Node) -> Iterator[s.Node]:
-    yield node
-    for child in node.children():
-        yield from _nodes(child)
+        return any(isinstance(node, s.TrackBinder) for node in self.tree.walk())
 
 
 def compile_query(text: str, compat: bool = False, source: str = "<query>") -> CompiledQuery:
@@ -101,7 +95,7 @@ def build_space(trace: LabelTrace, options: SearchOptions, compat: bool) -> Spac
 
 def _candidates(query: CompiledQuery, evaluator: Evaluator) -> dict[s.Binding, list[int]]:
     out = {}
-    for node in _nodes(query.tree):
+    for node in query.tree.walk():
         if isinstance(node, s.TrackBinder):
             rows, _ = evaluator.class_rows(node.binding.atom)
             objects = np.unique(evaluator.space.object[rows])

@@ -62,6 +62,12 @@ class Node:
                 if isinstance(item, Node):
                     yield item
 
+    def walk(self) -> Iterator[Node]:
+        """This node and every node inside it, depth first."""
+        yield self
+        for child in self.children():
+            yield from child.walk()
+
 
 _MISSING = object()
 

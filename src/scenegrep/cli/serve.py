@@ -1,0 +1,38 @@
+"""``scenegrep serve DATASET``: a local web page to browse a dataset, run queries and open matches.
+
+Binds to 127.0.0.1 only. Prints the address, then serves until Ctrl-C (exit 0).
+Exit codes: 0 stopped, 2 user error (not a dataset, port in use).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from ..errors import UserError
+
+
+def add_parser(subparsers: Any) -> None:
+    parser = subparsers.add_parser(
+        "serve",
+        help="a local web page over a dataset: browse traces, run queries, open the matches",
+        description="Serve a page on 127.0.0.1 to browse an ingested dataset's traces, type a SpRE or a Scenic "
+        "scene or scenario program, run it over the dataset and open every match in its interactive view.",
+    )
+    parser.add_argument("dataset", metavar="DATASET", help="an ingested dataset directory")
+    parser.add_argument("--port", type=int, default=8765, help="the port (default 8765; 0 picks a free one)")
+    parser.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes per query (default: all cores)")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..dataset import open_dataset
+    from ..view.serve import serve
+
+    dataset = open_dataset(args.dataset)
+    try:
+        serve(Path(dataset.path), args.port, args.jobs)
+    except OSError as exc:
+        raise UserError(f"cannot serve on 127.0.0.1:{args.port}: {exc.strerror or exc}") from None
+    return 0

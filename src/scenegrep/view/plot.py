@@ -1,0 +1,337 @@
+"""Views as pictures through matplotlib: a PNG of one frame, a GIF of a stretch of frames.
+
+The picture is the HTML view's (:mod:`.page`) without interaction: the top-down map (lanes,
+intersections, crosswalks) or the camera image area, the objects as oriented boxes coloured by
+kind, the corresponded objects filled in their program name's colour, labelled with the name
+and their path over the window drawn, and below a time line with the behaviour labels of the
+corresponded objects (or the number of objects per frame), the match window shaded.
+"""
+
+from __future__ import annotations
+
+import io
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import UserError
+from ..model.taxonomy import kind_of
+from .data import MatchView, TraceView
+from .style import MARKED_COLOUR, class_colours, program_colours
+
+GIF_MAX_FRAMES = 150
+"""A GIF shows at most this many frames (every k-th frame of a longer stretch)."""
+
+GIF_MARGIN = 10
+"""Frames shown before and after a match window in a GIF."""
+
+
+@dataclass(frozen=True)
+class Boxes:
+    """The boxes of one view in a form matplotlib takes: per row its frame, object (-1 none),
+    corners (n, 4, 2), centre (n, 2) and whether the query's classes mark it."""
+
+    frame: np.ndarray
+    object: np.ndarray
+    corners: np.ndarray
+    centre: np.ndarray
+    marked: np.ndarray
+
+    @classmethod
+    def of(cls, view: TraceView) -> Boxes:
+        if view.image_space:
+            return cls._image(view)
+        st = view.trace.states
+        length = np.maximum(np.nan_to_num(st.length, nan=0.5), 0.5) / 2
+        width = np.maximum(np.nan_to_num(st.width, nan=0.5), 0.5) / 2
+        fx, fy = -np.sin(st.heading), np.cos(st.heading)
+        a = np.array([1, 1, -1, -1])[None, :] * length[:, None]
+        b = np.array([1, -1, -1, 1])[None, :] * width[:, None]
+        corners = np.stack(
+            [st.x[:, None] + a * fx[:, None] + b * fy[:, None], st.y[:, None] + a * fy[:, None] - b * fx[:, None]],
+            axis=2,
+        )
+        marked = np.zeros(len(st), bool) if view.marked is None else view.marked
+        return cls(st.frame, st.object, corners, np.stack([st.x, st.y], axis=1), marked)
+
+    @classmethod
+    def _image(cls, view: TraceView) -> Boxes:
+        assert view.trace.images is not None
+        samples, boxes = view.trace.images.samples, view.trace.images.boxes
+        c, s = np.cos(boxes.rotation)[:, None], np.sin(boxes.rotation)[:, None]
+        u = np.array([-1, 1, 1, -1])[None, :] * boxes.w[:, None] / 2
+        v = np.array([-1, -1, 1, 1])[None, :] * boxes.h[:, None] / 2
+        corners = np.stack([boxes.cx[:, None] + u * c - v * s, boxes.cy[:, None] + u * s + v * c], axis=2)
+        marked = np.zeros(len(boxes), bool) if view.marked_boxes is None else view.marked_boxes
+        return cls(samples.frame[boxes.sample], boxes.object, corners, np.stack([boxes.cx, boxes.cy], axis=1), marked)
+
+
+def picture(view: TraceView, kind: str, match: MatchView | None = None, frame: int | None = None) -> bytes:
+    """The bytes of a ``kind`` 'png' picture of one frame (``frame``, a position; default the
+    window's first frame) or a 'gif' of the match window with :data:`GIF_MARGIN` frames around it
+    (the whole trace without a match)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    figure = Figure(view, match)
+    try:
+        if kind == "png":
+            figure.show_frame(_frame(view, match, frame))
+            buffer = io.BytesIO()
+            figure.figure.savefig(buffer, format="png", dpi=100)
+            return buffer.getvalue()
+        return figure.gif(_gif_frames(view, match))
+    finally:
+        figure.close()
+
+
+def _frame(view: TraceView, match: MatchView | None, frame: int | None) -> int:
+    if frame is None:
+        return match.first if match is not None else 0
+    if not 0 <= frame < view.trace.n_frames:
+        raise UserError(f"--frame {frame}: the trace has frames 0 to {view.trace.n_frames - 1}")
+    return frame
+
+
+def _gif_frames(view: TraceView, match: MatchView | None) -> np.ndarray:
+    first, last = (0, view.trace.n_frames - 1) if match is None else (match.first, match.last)
+    first, last = max(first - GIF_MARGIN, 0), min(last + GIF_MARGIN, view.trace.n_frames - 1)
+    step = max(1, -(-(last - first + 1) // GIF_MAX_FRAMES))
+    return np.arange(first, last + 1, step)
+
+
+class Figure:
+    """A matplotlib figure of a view whose boxes are redrawn per frame (see the module docstring)."""
+
+    def __init__(self, view: TraceView, match: MatchView | None):
+        import matplotlib.pyplot as plt
+
+        self.view, self.match = view, match
+        self.boxes = Boxes.of(view)
+        self.offsets = np.searchsorted(self.boxes.frame, np.arange(view.trace.n_frames + 1))
+        self.names = _names(view, match)
+        self.colours = program_colours([n for m in view.matches for n in m.correspondence])
+        self.figure = plt.figure(figsize=(10, 7.5), layout="constrained")
+        grid = self.figure.add_gridspec(2, 1, height_ratios=(6, 1))
+        self.ax = self.figure.add_subplot(grid[0])
+        self.timeline = self.figure.add_subplot(grid[1])
+        self._draw_static()
+
+    def close(self) -> None:
+        import matplotlib.pyplot as plt
+
+        plt.close(self.figure)
+
+    def _draw_static(self) -> None:
+        from matplotlib.collections import LineCollection, PolyCollection
+
+        ax, view = self.ax, self.view
+        ax.set_facecolor("#eef0f2")
+        if view.image_space:
+            width, height = _image_size(view)
+            ax.set_aspect("equal", adjustable="box")
+            ax.add_patch(_rectangle(width, height))
+            ax.set_xlim(0, width)
+            ax.set_ylim(height, 0)
+        else:
+            ax.set_aspect("equal", adjustable="datalim")
+            _draw_map(ax, view)
+            ax.update_datalim(self._extent())
+            ax.margins(0)
+            ax.autoscale_view()
+        self.collection = PolyCollection([], zorder=3)
+        ax.add_collection(self.collection, autolim=False)
+        paths = [self._path(row) for row in self.names]
+        self.paths = LineCollection(
+            [p for p in paths if len(p) > 1],
+            colors=[self.colours[n] for row, n in self.names.items() if len(self._path(row)) > 1],
+            linestyles="dashed",
+            linewidths=1.5,
+            alpha=0.7,
+            zorder=2,
+        )
+        ax.add_collection(self.paths, autolim=False)
+        self.texts: list = []
+        self._draw_timeline()
+        title = view.trace.name if self.match is None else _match_title(view, self.match)
+        ax.set_title(title, fontsize=11, loc="left")
+
+    def _path(self, row: int) -> np.ndarray:
+        keep = self.boxes.object == row
+        if self.match is not None:
+            keep &= (self.boxes.frame >= self.match.first) & (self.boxes.frame <= self.match.last)
+        return self.boxes.centre[keep]
+
+    def _extent(self) -> np.ndarray:
+        """Two corners of the area to show: the corresponded objects' (all objects' without a match)
+        positions with 15 m around them."""
+        rows = np.isin(self.boxes.object, list(self.names)) if self.names else np.ones(len(self.boxes.frame), bool)
+        points = self.boxes.centre[rows]
+        points = points[np.isfinite(points).all(axis=1)]
+        if len(points) == 0:
+            return np.array([[0.0, 0.0], [100.0, 100.0]])
+        return np.array([points.min(axis=0) - 15, points.max(axis=0) + 15])
+
+    def _draw_timeline(self) -> None:
+        ax, view = self.timeline, self.view
+        n = view.trace.n_frames
+        ax.set_xlim(0, n)
+        ax.set_yticks([])
+        ax.set_xlabel("frame position")
+        if self.names and view.trace.behaviours is not None and not view.image_space:
+            _label_rows(ax, view, self.names)
+        else:
+            counts = np.diff(self.offsets)
+            marked = np.bincount(self.boxes.frame[self.boxes.marked], minlength=n)
+            ax.bar(np.arange(n), counts, width=1.0, align="edge", color="#c9ced6", label="objects")
+            if marked.any():
+                ax.bar(np.arange(n), marked, width=1.0, align="edge", color=MARKED_COLOUR, label="query's classes")
+            ax.legend(loc="upper right", fontsize=7)
+        if self.match is not None:
+            ax.axvspan(self.match.first, self.match.last + 1, color="#e63946", alpha=0.2, zorder=3)
+            for edge in (self.match.first, self.match.last + 1):
+                ax.axvline(edge, color="#e63946", linewidth=2, zorder=3)
+        self.cursor = ax.axvline(0, color="#111", linewidth=1.5)
+
+    def show_frame(self, frame: int) -> None:
+        """Draw the boxes of frame position ``frame``."""
+        rows = np.arange(self.offsets[frame], self.offsets[frame + 1])
+        objects = self.boxes.object[rows]
+        kinds = _kind_colours(self.view)
+        in_window = self.match is not None and self.match.first <= frame <= self.match.last
+        faces, edges, widths = [], [], []
+        for row, obj in zip(rows.tolist(), objects.tolist()):
+            name = self.names.get(obj)
+            kind = kinds[obj] if obj >= 0 else "#bdbdbd"
+            marked = in_window and bool(self.boxes.marked[row])
+            fill = self.colours[name] if name is not None else kind
+            faces.append("none" if self.view.image_space and name is None else fill)
+            edges.append("#111" if name is not None else MARKED_COLOUR if marked else kind)
+            widths.append(2.0 if name is not None or marked else 0.8)
+        self.collection.set_verts(self.boxes.corners[rows])
+        self.collection.set_facecolors(faces)
+        self.collection.set_edgecolors(edges)
+        self.collection.set_linewidths(widths)
+        for text in self.texts:
+            text.remove()
+        named = [(row, obj) for row, obj in zip(rows.tolist(), objects.tolist()) if obj in self.names]
+        self.texts = [
+            self.ax.annotate(
+                self.names[obj],
+                self.boxes.centre[row],
+                xytext=(8, 8 + 13 * k),
+                textcoords="offset points",
+                fontsize=9,
+                fontweight="bold",
+                zorder=4,
+                arrowprops={"arrowstyle": "-", "color": "#555", "linewidth": 0.6},
+            )
+            for k, (row, obj) in enumerate(named)
+        ]
+        self.cursor.set_xdata([frame + 0.5, frame + 0.5])
+        time = self.view.trace.frame_time[frame] - self.view.trace.frame_time[0]
+        self.ax.set_xlabel(f"frame {int(self.view.trace.frame_index[frame])}" + _seconds(f" · {time:.2f} s", time))
+
+    def gif(self, frames: np.ndarray) -> bytes:
+        """The frames as an animated GIF at the recording's speed (at most 20 frames/s), 72 dpi."""
+        from PIL import Image
+
+        self.figure.set_dpi(72)
+        images = []
+        for frame in frames.tolist():
+            self.show_frame(frame)
+            self.figure.canvas.draw()
+            rgba = np.asarray(self.figure.canvas.buffer_rgba())
+            images.append(Image.fromarray(rgba[:, :, :3]).quantize(colors=128))
+        period = _period(self.view) * (frames[1] - frames[0] if len(frames) > 1 else 1)
+        buffer = io.BytesIO()
+        duration = max(int(round(1000 * period)), 50)
+        images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:], duration=duration, loop=0)
+        return buffer.getvalue()
+
+
+def _names(view: TraceView, match: MatchView | None) -> dict[int, str]:
+    """Object row -> program name of the match."""
+    if match is None:
+        return {}
+    rows = view.trace.objects.row_of()
+    return {rows[object_id]: name for name, object_id in match.correspondence.items()}
+
+
+def _kind_colours(view: TraceView) -> list[str]:
+    colours = class_colours()
+    return [colours[kind_of(c)] for c in view.trace.objects.category]
+
+
+def _match_title(view: TraceView, match: MatchView) -> str:
+    index, time = view.trace.frame_index, view.trace.frame_time - view.trace.frame_time[0]
+    seconds = _seconds(f" ({time[match.first]:.1f}-{time[match.last]:.1f} s)", time[match.first])
+    return f"{view.trace.name}: match {match.number}, frames {index[match.first]}-{index[match.last]}{seconds}"
+
+
+def _seconds(text: str, value: float) -> str:
+    """``text`` when the trace has timestamps (``value`` is finite), else ''."""
+    return text if np.isfinite(value) else ""
+
+
+def _period(view: TraceView) -> float:
+    """The frame period in seconds (0.1 for a stream without timestamps)."""
+    period = view.trace.frame_period
+    return period if np.isfinite(period) and period > 0 else 0.1
+
+
+def _image_size(view: TraceView) -> tuple[float, float]:
+    assert view.trace.images is not None
+    samples = view.trace.images.samples
+    return float(samples.image_width.max(initial=0) or 1600), float(samples.image_height.max(initial=0) or 900)
+
+
+def _rectangle(width: float, height: float):
+    from matplotlib.patches import Rectangle
+
+    return Rectangle((0, 0), width, height, facecolor="#20242a", edgecolor="#888", zorder=0)
+
+
+def _draw_map(ax, view: TraceView) -> None:
+    from matplotlib.collections import PolyCollection
+
+    from .payload import rings
+
+    road_map = view.road_map
+    if road_map is None:
+        return
+    layers = (
+        ([lane.polygon for lane in road_map.lanes], "#dfe3e8", "#c3c8cf"),
+        ([area.polygon for area in road_map.intersections], "#b4bcc8", "none"),
+        ([area.polygon for area in road_map.crosswalks], "#ffffff", "#b0b6bf"),
+    )
+    for polygons, face, edge in layers:
+        found = rings(polygons)
+        if found:
+            ax.add_collection(
+                PolyCollection(found, facecolors=face, edgecolors=edge, linewidths=0.6, alpha=0.9, zorder=1),
+                autolim=False,
+            )
+
+
+def _label_rows(ax, view: TraceView, names: dict[int, str]) -> None:
+    """One row per corresponded object: its behaviour label set per frame, a colour per set."""
+    import matplotlib.pyplot as plt
+
+    trace = view.trace
+    assert trace.behaviours is not None
+    vocabulary = np.asarray(trace.behaviours.vocabulary, dtype=object)
+    unique, codes = np.unique(trace.behaviours.member, axis=0, return_inverse=True)
+    codes = codes.reshape(-1)
+    palette = plt.get_cmap("tab10")
+    used: dict[int, str] = {}
+    for k, (row, name) in enumerate(names.items()):
+        mine = trace.states.object == row
+        for code in np.unique(codes[mine]).tolist():
+            frames = trace.states.frame[mine & (codes == code)]
+            ax.broken_barh([(f, 1) for f in frames.tolist()], (k + 0.1, 0.8), color=palette(code % 10))
+            used[code] = ",".join(vocabulary[unique[code]].tolist()) or "(none)"
+        ax.text(1, k + 0.5, name, va="center", fontsize=8, fontweight="bold")
+    ax.set_ylim(0, len(names))
+    handles = [plt.Rectangle((0, 0), 1, 1, color=palette(code % 10)) for code in used]
+    ax.legend(handles, list(used.values()), loc="upper right", fontsize=7, ncols=min(len(used), 4))

@@ -1,0 +1,138 @@
+"""Where views get their data: a results table and the dataset it was computed on, or a trace file.
+
+A results table names traces by ``trace_id``; their Parquet files and road maps are found in
+the dataset's catalog. The dataset is the one given, or the one the results file lies in
+(``DATASET/runs/<run_id>/results.parquet``). The query behind the results (for the query text
+and a SpRE's classes) is the catalog's run of the table's ``run_id``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pyarrow.compute as pc
+
+from .. import readers
+from ..dataset.catalog import CATALOG_FILE, Catalog
+from ..dataset.results import Results
+from ..errors import UserError, at
+from .data import QueryInfo, TraceView, build_view
+
+
+def find_dataset(path: str | Path) -> Path | None:
+    """The dataset directory holding ``path`` (a results file), or None."""
+    for folder in Path(path).resolve().parents:
+        if (folder / CATALOG_FILE).is_file():
+            return folder
+    return None
+
+
+@dataclass(frozen=True)
+class ResultsSource:
+    """A results table with the dataset that holds its traces (``root``) and its query."""
+
+    results: Results
+    root: Path
+    query: QueryInfo | None
+
+    @classmethod
+    def open(cls, path: str | Path, dataset: str | Path | None = None) -> ResultsSource:
+        """The results at ``path`` (Parquet, JSON lines or CSV) and their dataset (UserError if
+        none is given and the file does not lie in one)."""
+        results = Results.read(path)
+        root = Path(dataset).resolve() if dataset is not None else find_dataset(path)
+        if root is None:
+            raise UserError("the results are not inside a dataset; name it with --dataset DATASET", at(path))
+        return cls(results, root, query_of(root, results.run_id))
+
+    @classmethod
+    def of_run(cls, root: Path, results: Results) -> ResultsSource:
+        """A run's results over the dataset at ``root``."""
+        return cls(results, root, query_of(root, results.run_id))
+
+    def trace_ids(self) -> list[str]:
+        """The traces of the table, in its order, each once."""
+        return list(dict.fromkeys(self.results.table["trace_id"].to_pylist()))
+
+    def rows_of(self, trace_id: str) -> list[dict[str, Any]]:
+        table = self.results.table
+        return table.filter(pc.equal(table["trace_id"], trace_id)).to_pylist()
+
+    def view(self, trace_id: str) -> TraceView:
+        """The view of one trace of the table with its rows."""
+        trace, road_map = load_trace(self.root, trace_id)
+        return build_view(trace, road_map, self.rows_of(trace_id), self.query, trace_id)
+
+    def matched_trace_ids(self) -> list[str]:
+        """The traces with a match, in table order."""
+        return list(dict.fromkeys(self.results.matches["trace_id"].to_pylist()))
+
+    def match_row(self, number: int) -> dict[str, Any]:
+        """The ``number``-th match of the table (0-based, in table order)."""
+        matches = self.results.matches
+        if not 0 <= number < matches.num_rows:
+            raise UserError(
+                f"--match {number}: the results have {matches.num_rows} matches (0 to {matches.num_rows - 1})"
+            )
+        return matches.slice(number, 1).to_pylist()[0]
+
+
+def query_of(root: Path, run_id: str) -> QueryInfo | None:
+    """The query of a run of the dataset (None when the run is unknown)."""
+    if not run_id:
+        return None
+    with Catalog(root, read_only=True) as catalog:
+        found = catalog.rows("SELECT kind, query, options FROM runs WHERE run_id = ?", [run_id])
+    if not found:
+        return None
+    kind, text, options = found[0]
+    return QueryInfo(kind, text, json.loads(options or "{}"))
+
+
+def load_trace(root: Path, trace_id: str) -> tuple[Any, Any]:
+    """A dataset's trace and its road map (None without one); UserError for an unknown trace."""
+    with Catalog(root, read_only=True) as catalog:
+        found = catalog.rows(
+            "SELECT t.file, m.file FROM traces t LEFT JOIN maps m ON t.map_id = m.map_id WHERE t.trace_id = ?",
+            [trace_id],
+        )
+    if not found:
+        raise UserError(f"the dataset has no trace {trace_id!r}", at(root))
+    trace_file, map_file = found[0]
+    trace = readers.read_trace(root / trace_file, "scenegrep-parquet")
+    road_map = None if map_file is None else readers.read_map(root / map_file)
+    return trace, road_map
+
+
+def trace_file_view(path: str | Path, map_path: str | Path | None = None) -> TraceView:
+    """The view of a trace file of any readable format, on its own map or ``map_path``."""
+    trace = readers.read_trace(path)
+    source = map_path if map_path is not None else trace.map_source
+    road_map = None if source is None else readers.read_map(source)
+    return build_view(trace, road_map)
+
+
+def is_results(path: str | Path) -> bool:
+    """Whether ``path`` holds a results table (rather than a trace): a Parquet, JSON-lines or CSV
+    file with the results' ``trace_id`` and ``status`` columns."""
+    import pyarrow.parquet as pq
+
+    path = Path(path)
+    if not path.is_file():
+        return False
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".parquet":
+            names = set(pq.read_schema(path).names)
+        elif suffix in (".json", ".jsonl", ".csv"):
+            with open(path, encoding="utf-8") as stream:
+                first = stream.readline()
+            names = set(json.loads(first)) if suffix != ".csv" else set(first.strip().split(","))
+        else:
+            return False
+    except (OSError, ValueError, TypeError):
+        return False
+    return {"trace_id", "status"} <= names

@@ -1,0 +1,78 @@
+"""Fixtures of the view tests: query runs over the real dataset, and a headless Chromium."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from scenegrep.dataset import open_dataset
+from scenegrep.dataset.run import RunOptions
+from tests.conftest import REPO
+
+ARTIFACTS = REPO / "test-artifacts"
+"""Screenshots the browser tests save (git ignores the folder)."""
+
+CHROMIUM = "/usr/bin/chromium"
+CHROMEDRIVER = "/usr/bin/chromedriver"
+CHROMIUM_FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--window-size=1400,900",
+)
+
+
+@pytest.fixture(scope="session")
+def scenario_run(real_dataset: Path):
+    """The s1 scenario (window 75, explained) over the real dataset and the sample traces."""
+    program = REPO / "examples" / "queries" / "s1_lane_change_stationary_car.scenic"
+    return open_dataset(real_dataset).scenario(program, 75, explain=True, run=RunOptions(jobs=2))
+
+
+@pytest.fixture(scope="session")
+def spre_run(real_dataset: Path):
+    """A SpRE over the real dataset: pedestrians in every frame of a stretch."""
+    return open_dataset(real_dataset).spre("[[:pedestrian:]]+", run=RunOptions(jobs=2))
+
+
+@pytest.fixture(scope="session")
+def browser():
+    """A Selenium driver of Debian's headless Chromium (skipped where it is not installed, except
+    under CI, where .ci/run installs it and its absence is a failure)."""
+    if not (Path(CHROMIUM).exists() and Path(CHROMEDRIVER).exists()):
+        if os.environ.get("CI"):
+            pytest.fail("Chromium and ChromeDriver must be installed (apt-get install chromium chromium-driver)")
+        pytest.skip("Debian's chromium and chromium-driver are not installed")
+    os.environ.setdefault("SE_OFFLINE", "true")
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    options = webdriver.ChromeOptions()
+    options.binary_location = CHROMIUM
+    for flag in CHROMIUM_FLAGS:
+        options.add_argument(flag)
+    profile = tempfile.mkdtemp(prefix="scenegrep-chromium-")
+    options.add_argument(f"--user-data-dir={profile}")
+    driver = webdriver.Chrome(options=options, service=Service(CHROMEDRIVER))
+    try:
+        yield driver
+    finally:
+        driver.quit()
+        shutil.rmtree(profile, ignore_errors=True)
+
+
+def screenshot(driver, name: str) -> Path:
+    """Save the browser's screen as test-artifacts/NAME.png."""
+    ARTIFACTS.mkdir(exist_ok=True)
+    path = ARTIFACTS / f"{name}.png"
+    driver.save_screenshot(str(path))
+    return path

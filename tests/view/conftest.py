@@ -52,6 +52,18 @@ def browser():
         if os.environ.get("CI"):
             pytest.fail("Chromium and ChromeDriver must be installed (apt-get install chromium chromium-driver)")
         pytest.skip("Debian's chromium and chromium-driver are not installed")
+    profile = tempfile.mkdtemp(prefix="scenegrep-chromium-")
+    driver = chromium_driver(profile)
+    try:
+        yield driver
+    finally:
+        driver.quit()
+        shutil.rmtree(profile, ignore_errors=True)
+
+
+def chromium_driver(profile: str):
+    """A Selenium driver of Debian's Chromium, headless, with a fresh profile folder and no
+    background network traffic (the flags the machine notes ask for)."""
     os.environ.setdefault("SE_OFFLINE", "true")
     from selenium import webdriver
     from selenium.webdriver.chrome.service import Service
@@ -60,14 +72,8 @@ def browser():
     options.binary_location = CHROMIUM
     for flag in CHROMIUM_FLAGS:
         options.add_argument(flag)
-    profile = tempfile.mkdtemp(prefix="scenegrep-chromium-")
     options.add_argument(f"--user-data-dir={profile}")
-    driver = webdriver.Chrome(options=options, service=Service(CHROMEDRIVER))
-    try:
-        yield driver
-    finally:
-        driver.quit()
-        shutil.rmtree(profile, ignore_errors=True)
+    return webdriver.Chrome(options=options, service=Service(CHROMEDRIVER))
 
 
 def screenshot(driver, name: str) -> Path:

@@ -152,6 +152,7 @@ class Figure:
         )
         ax.add_collection(self.paths, autolim=False)
         self.texts: list = []
+        self.label = ax.text(0.01, 0.01, "", transform=ax.transAxes, fontsize=10, zorder=5)
         self._draw_timeline()
         title = view.trace.name if self.match is None else _match_title(view, self.match)
         ax.set_title(title, fontsize=11, loc="left")
@@ -225,24 +226,34 @@ class Figure:
                 fontweight="bold",
                 zorder=4,
                 arrowprops={"arrowstyle": "-", "color": "#555", "linewidth": 0.6},
+                animated=self.collection.get_animated(),
             )
             for k, (row, obj) in enumerate(named)
         ]
         self.cursor.set_xdata([frame + 0.5, frame + 0.5])
         time = self.view.trace.frame_time[frame] - self.view.trace.frame_time[0]
-        self.ax.set_xlabel(f"frame {int(self.view.trace.frame_index[frame])}" + _seconds(f" · {time:.2f} s", time))
+        self.label.set_text(f"frame {int(self.view.trace.frame_index[frame])}" + _seconds(f" · {time:.2f} s", time))
 
     def gif(self, frames: np.ndarray) -> bytes:
-        """The frames as an animated GIF at the recording's speed (at most 20 frames/s), 72 dpi."""
+        """The frames as an animated GIF at the recording's speed (at most 20 frames/s), 72 dpi.
+        The map and the time line are drawn once; each frame redraws only what moves (blitting)."""
         from PIL import Image
 
+        moving = (self.collection, self.label, self.cursor)
+        for artist in moving:
+            artist.set_animated(True)
         self.figure.set_dpi(72)
+        canvas = self.figure.canvas
+        canvas.draw()
+        background = canvas.copy_from_bbox(self.figure.bbox)
         images = []
         for frame in frames.tolist():
             self.show_frame(frame)
-            self.figure.canvas.draw()
-            rgba = np.asarray(self.figure.canvas.buffer_rgba())
-            images.append(Image.fromarray(rgba[:, :, :3]).quantize(colors=128))
+            canvas.restore_region(background)
+            for artist in (*moving, *self.texts):
+                artist.axes.draw_artist(artist)
+            rgb = np.asarray(canvas.buffer_rgba())[:, :, :3]
+            images.append(Image.fromarray(rgb).quantize(colors=96, method=Image.Quantize.FASTOCTREE))
         period = _period(self.view) * (frames[1] - frames[0] if len(frames) > 1 else 1)
         buffer = io.BytesIO()
         duration = max(int(round(1000 * period)), 50)

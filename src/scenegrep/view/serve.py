@@ -95,6 +95,8 @@ class Handler(BaseHTTPRequestHandler):
 
     # ------------------------------------------------------------------ pages
     def _run(self, request: dict[str, Any]) -> dict[str, Any]:
+        if not isinstance(request, dict) or not {"kind", "text"} <= set(request):
+            raise UserError("bad query request: it needs a 'kind' and a 'text'")
         options = {k: v for k, v in dict(request.get("options") or {}).items() if v not in (None, "")}
         spec = QuerySpec.of(str(request["kind"]), str(request["text"]), "<query>", **options)
         results = run_query(self.server.dataset.path, spec, RunOptions(jobs=self.server.jobs))

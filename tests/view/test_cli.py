@@ -163,3 +163,19 @@ def test_serve_answers_unknown_pages_and_runs(server):
     assert fetch(server.url + "view/nope")[0] == 400
     assert json.loads(fetch(server.url + "report/abc")[1])["error"] == "the dataset has no run 'abc'"
     assert fetch(server.url + "nothing/here")[0] == 404
+
+
+def test_serve_runs_a_typed_scenic_scene_like_the_api(server, real_dataset):
+    from scenegrep.dataset import open_dataset
+
+    program = REPO / "examples" / "scenes" / "fig3_car_ahead.scenic"
+    options = {"tolerance_position": 1.0, "tolerance_heading": 0.2618}
+    request = {"kind": "scene", "text": program.read_text(), "options": {**options, "explain": False}}
+    status, body = fetch(server.url + "api/query", request)
+    assert status == 200
+    expected = open_dataset(real_dataset).scene(program, **options)
+    answer = json.loads(body)
+    assert answer["counts"] == expected.counts() and answer["counts"]["matched"] > 0
+    assert [(m["trace_id"], m["start_frame"]) for m in answer["matches"]] == [
+        (r["trace_id"], r["start_frame"]) for r in expected.matches.to_pylist()
+    ]

@@ -31,16 +31,17 @@ def script_json(document: Any) -> str:
     return json.dumps(document, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
 
 
+def html_page(title: str, style: str, body: str, attributes: dict[str, str] | None = None) -> str:
+    """A whole HTML document: ``title`` (text), ``style`` (CSS) and ``body`` (HTML) with the body
+    element's ``attributes``."""
+    attributes_text = "".join(f' {name}="{html.escape(value)}"' for name, value in (attributes or {}).items())
+    return asset("page.html").format(title=html.escape(title), style=style, attributes=attributes_text, body=body)
+
+
 def view_page(view: TraceView, back_link: str | None = None, initial_match: int | None = None) -> str:
     """The HTML page of a view; ``back_link`` (a URL) adds a link back to a report or index;
     ``initial_match`` (a match number) is shown first unless the URL's fragment names another."""
-    title = f"scenegrep · {view.trace.name}"
     back = "" if back_link is None else f'<a id="back" href="{html.escape(back_link)}">&larr; all results</a>'
-    return asset("view.html").format(
-        title=html.escape(title),
-        back=back,
-        initial="" if initial_match is None else str(initial_match),
-        style=asset("view.css"),
-        data=script_json(payload(view)),
-        script=asset("view.js"),
-    )
+    body = asset("view.html").format(back=back, data=script_json(payload(view)), script=asset("view.js"))
+    attributes = {} if initial_match is None else {"data-initial-match": str(initial_match)}
+    return html_page(f"scenegrep · {view.trace.name}", asset("view.css"), body, attributes)

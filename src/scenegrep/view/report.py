@@ -18,7 +18,7 @@ from typing import Any
 from ..dataset.catalog import Catalog
 from ..writers.atomic import atomic_path
 from .charts import bar_chart, histogram
-from .page import asset, view_page
+from .page import asset, html_page, view_page
 from .sources import ResultsSource
 
 MOST_BARS = 40
@@ -53,9 +53,7 @@ def report_page(source: ResultsSource, link: Callable[[str, int], str]) -> str:
     matches = [r for r in rows if r["status"] == "match"]
     kinds = _object_kinds(source.root, {r["trace_id"] for r in rows})
     query = source.query
-    return asset("report.html").format(
-        title=html.escape(f"scenegrep report · {source.results.run_id or 'results'}"),
-        style=asset("report.css"),
+    body = asset("report.html").format(
         query=html.escape(f"{query.kind}: {query.text}" if query else "(query unknown)"),
         run=html.escape(f"run {source.results.run_id} ({source.results.status})" if source.results.run_id else ""),
         summary=_summary(source, matches),
@@ -63,6 +61,7 @@ def report_page(source: ResultsSource, link: Callable[[str, int], str]) -> str:
         matches=_matches_table(matches, link),
         traces=_traces_table(rows, link),
     )
+    return html_page(f"scenegrep report · {source.results.run_id or 'results'}", asset("report.css"), body)
 
 
 def _object_kinds(root: Path, trace_ids: set[str]) -> dict[tuple[str, str], str]:

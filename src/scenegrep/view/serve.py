@@ -28,7 +28,7 @@ from ..dataset.results import Results
 from ..dataset.run import RunOptions, run_query
 from ..errors import UserError
 from .data import build_view
-from .page import asset, view_page
+from .page import asset, html_page, view_page
 from .report import report_page
 from .sources import ResultsSource, load_trace
 
@@ -154,7 +154,8 @@ def _finite(value: Any) -> Any:
 
 
 def _index_page() -> str:
-    return asset("serve.html").format(style=asset("report.css") + asset("serve.css"), script=asset("serve.js"))
+    body = asset("serve.html").format(script=asset("serve.js"))
+    return html_page("scenegrep serve", asset("report.css") + asset("serve.css"), body)
 
 
 def _runs(dataset: Dataset) -> list[dict[str, Any]]:

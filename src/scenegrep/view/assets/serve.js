@@ -5,8 +5,11 @@
   const $ = (id) => document.getElementById(id);
   const EXAMPLES = {
     spre: "[[:pedestrian:]]+",
-    scene: "param map = localPath('map.xodr')\nmodel scenic.simulators.newtonian.driving_model\nego = new Car\nother = new Car ahead of ego by (5, 15)",
-    scenario: "model scenic.simulators.newtonian.driving_model\nbehavior EgoBehavior():\n    do FollowLaneBehavior()\nego = new Car with behavior EgoBehavior()",
+    scene: "model scenic.domains.driving.model\nego = new Car on road\notherCar = new Car ahead of ego by Range(4, 10)",
+    scenario: "model scenic.simulators.newtonian.driving_model\nbehavior EgoBehavior():\n    try:\n" +
+      "        do FollowLaneBehavior()\n    interrupt when (distance to parkedCar) < Range(1, 15):\n" +
+      "        do LaneChangeBehavior()\n        do FollowLaneBehavior()\n" +
+      "ego = new Car with behavior EgoBehavior()\nparkedCar = new Car on visible ego.lane",
   };
   function cell(row, content) {
     const td = document.createElement("td");

@@ -73,6 +73,7 @@ def chromium_driver(profile: str):
     for flag in CHROMIUM_FLAGS:
         options.add_argument(flag)
     options.add_argument(f"--user-data-dir={profile}")
+    options.set_capability("goog:loggingPrefs", {"browser": "SEVERE"})
     return webdriver.Chrome(options=options, service=Service(CHROMEDRIVER))
 
 

@@ -134,6 +134,24 @@ def test_spre_view_marks_the_named_class_on_real_nuscenes(browser, real_dataset,
     screenshot(browser, "spre-nuscenes-view")
 
 
+def test_every_view_of_real_av2_nuscenes_and_sample_matches_draws_without_errors(
+    browser, real_dataset, spre_run, tmp_path
+):
+    report = tmp_path / "report.html"
+    write_report(ResultsSource.of_run(real_dataset, spre_run), report)
+    browser.get_log("browser")
+    rows = spre_run.matches.to_pylist()
+    names = {row["name"] for row in rows}
+    assert {"7fab2350-7eaf-3b7e-a39d-6937a4c1bede", "scene-0061", "s3_pass_pedestrian-000"} <= names
+    for k, row in enumerate(rows):
+        expected = open_view_from_report(browser, report, k)
+        wait_for(browser, "document.body.dataset.frame !== undefined")
+        assert browser.execute_script("return scenegrepView.window()") == expected["window"], row["name"]
+        assert browser.execute_script("return scenegrepView.frame()") == row["start_frame"]
+        browser.execute_script("scenegrepView.setFrame(1e9)")  # the last frame draws too
+        assert browser.get_log("browser") == [], row["name"]
+
+
 def test_serve_runs_a_typed_query_and_opens_a_match(browser, real_dataset):
     from selenium.webdriver.common.by import By
 

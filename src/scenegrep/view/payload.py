@@ -15,7 +15,7 @@ import shapely
 from ..model import LabelTrace, RoadMap
 from ..model.taxonomy import kind_of
 from .data import TraceView
-from .style import class_colours, program_colours
+from .style import MARKED_COLOUR, class_colours, program_colours
 
 DIGITS = 2
 """Decimals kept for metres, pixels and radians."""
@@ -43,6 +43,7 @@ def payload(view: TraceView) -> dict[str, Any]:
             for m in view.matches
         ],
         "program_colours": program_colours(names),
+        "marked_colour": MARKED_COLOUR,
         "note": view.note,
         "query": None if view.query is None else {"kind": view.query.kind, "text": view.query.text},
     }

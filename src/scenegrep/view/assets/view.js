@@ -136,9 +136,9 @@
         polygon(pts, data.program_colours[name], "#111", 2);
         labels.push([pts, name]);
       } else if (data.space === "image") {
-        polygon(pts, null, marked ? "#ff7f0e" : kindColour, marked ? 3 : 1.5);
+        polygon(pts, null, marked ? data.marked_colour : kindColour, marked ? 3 : 1.5);
       } else {
-        polygon(pts, kindColour, marked ? "#ff7f0e" : (o >= 0 && data.objects.id[o] === data.ego ? "#111" : null),
+        polygon(pts, kindColour, marked ? data.marked_colour : (o >= 0 && data.objects.id[o] === data.ego ? "#111" : null),
           marked ? 3 : 1.5);
       }
       if (data.space !== "image") {
@@ -201,11 +201,11 @@
       for (let r = rows.offsets[f]; r < rows.offsets[f + 1]; r++) if (rows.marked.length && rows.marked[r]) marked++;
       const all = rows.offsets[f + 1] - rows.offsets[f], h = labelCanvas.height;
       lctx.fillStyle = "#c9ced6"; lctx.fillRect(f * step, h - (h * all) / most, Math.ceil(step), (h * all) / most);
-      lctx.fillStyle = "#ff7f0e"; lctx.fillRect(f * step, h - (h * marked) / most, Math.ceil(step), (h * marked) / most);
+      lctx.fillStyle = data.marked_colour; lctx.fillRect(f * step, h - (h * marked) / most, Math.ceil(step), (h * marked) / most);
     }
     $("label-legend").innerHTML = rows.marked.length
       ? '<span><i style="background:#c9ced6"></i>objects per frame</span>' +
-        '<span><i style="background:#ff7f0e"></i>of the classes the query names</span>'
+        `<span><i style="background:${data.marked_colour}"></i>of the classes the query names</span>`
       : '<span><i style="background:#c9ced6"></i>objects per frame</span>';
   }
   function drawTimeline() {
@@ -265,7 +265,7 @@
     }
     if (rows.marked.length) {
       const li = document.createElement("li");
-      li.innerHTML = '<span class="swatch" style="border: 3px solid #ff7f0e"></span>' +
+      li.innerHTML = `<span class="swatch" style="border: 3px solid ${data.marked_colour}"></span>` +
         "<span>objects of the classes the query names (in the window)</span>";
       legend.append(li);
     }

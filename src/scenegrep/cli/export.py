@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 from typing import Any
 
 
@@ -30,12 +29,7 @@ def run(args: argparse.Namespace) -> int:
     from ..dataset.export import write_mcap_events
     from ..dataset.results import Results
 
-    source = Path(args.results)
-    if source.is_dir():
-        source = source / "results.parquet"
-    results = Results.read(source)
-    run_id = source.parent.name if source.name == "results.parquet" else ""
-    count = write_mcap_events(Results(results.table, run_id), args.mcap)
+    count = write_mcap_events(Results.read(args.results), args.mcap)
     if not args.quiet:
         print(f"scenegrep: {count} matches written as Foxglove events to {args.mcap}", file=sys.stderr)
     return 0

@@ -38,8 +38,7 @@ def run(args: argparse.Namespace) -> int:
 
     if Path(args.output).suffix.lower() != ".html":
         raise UserError(f"-o {args.output}: the report is an .html file")
-    results = Path(args.results)
-    source = ResultsSource.open(results / "results.parquet" if results.is_dir() else results, args.dataset)
+    source = ResultsSource.open(args.results, args.dataset)
     show_bar = sys.stderr.isatty() and not args.quiet
 
     def progress(views: Any) -> Any:

@@ -15,6 +15,9 @@ import pyarrow.parquet as pq
 from ..errors import UserError, at
 from .queries import RESULTS_SCHEMA
 
+RESULTS_FILE = "results.parquet"
+"""The results file of a run directory (``DATASET/runs/<run_id>/results.parquet``)."""
+
 RUN_ID_KEY = b"scenegrep.run_id"
 STATUS_KEY = b"scenegrep.status"
 """Keys of the run's id and status in a results Parquet file's metadata."""
@@ -31,9 +34,13 @@ class Results:
 
     @classmethod
     def read(cls, path: str | Path) -> Results:
-        """Results from a file a run wrote: Parquet, JSON lines (``.json``, ``.jsonl``) or CSV
-        (UserError if it is not a results table)."""
-        suffix = Path(path).suffix.lower()
+        """Results from a run directory or a file a run wrote: Parquet, JSON lines (``.json``,
+        ``.jsonl``) or CSV (UserError if it is not a results table). The run id is the one the
+        Parquet file records, else the name of the run directory its ``results.parquet`` lies in."""
+        path = Path(path)
+        if path.is_dir():
+            path = path / RESULTS_FILE
+        suffix = path.suffix.lower()
         try:
             if suffix in (".json", ".jsonl"):
                 table = _from_rows(_json_rows(path))
@@ -47,7 +54,7 @@ class Results:
         if missing:
             raise UserError(f"not a scenegrep results table (no column {sorted(missing)[0]!r})", at(path))
         metadata = table.schema.metadata or {}
-        run_id = metadata.get(RUN_ID_KEY, b"").decode()
+        run_id = metadata.get(RUN_ID_KEY, b"").decode() or (path.parent.name if path.name == RESULTS_FILE else "")
         status = metadata.get(STATUS_KEY, b"finished").decode()
         return cls(table.select(RESULTS_SCHEMA.names).cast(RESULTS_SCHEMA), run_id, status)
 

@@ -28,7 +28,7 @@ from .catalog import Catalog
 from .execute import default_jobs, run_all
 from .plan import Plan, needs_of, plan
 from .queries import QuerySpec, TraceTask, compiled, results_table, run_tasks
-from .results import Results
+from .results import RESULTS_FILE, Results
 
 MAX_CHUNK = 64
 """At most this many traces per task: results are saved (and progress shown) per chunk."""
@@ -145,7 +145,7 @@ def _finish(root: Path, run_id: str, status: str, parts: Path, planned: Plan) ->
         [("trace_id", "ascending"), ("match", "ascending")]
     )
     results = Results(table, run_id, status)
-    results.write_parquet(root / "runs" / run_id / "results.parquet")
+    results.write_parquet(root / "runs" / run_id / RESULTS_FILE)
     with Catalog(root) as catalog:
         catalog.finish_run(run_id, status, table, results.counts())
     return results

@@ -24,7 +24,7 @@ from urllib.parse import parse_qs, quote, unquote, urlsplit
 
 from ..dataset import Dataset
 from ..dataset.queries import QuerySpec
-from ..dataset.results import Results
+from ..dataset.results import RESULTS_FILE, Results
 from ..dataset.run import RunOptions, run_query
 from ..errors import UserError
 from .data import build_view
@@ -112,10 +112,10 @@ class Handler(BaseHTTPRequestHandler):
         }
 
     def _results(self, run_id: str) -> Results:
-        path = self.server.dataset.path / "runs" / Path(run_id).name / "results.parquet"
-        if not run_id or not path.is_file():
+        folder = self.server.dataset.path / "runs" / Path(run_id).name
+        if not run_id or not (folder / RESULTS_FILE).is_file():
             raise UserError(f"the dataset has no run {run_id!r}")
-        return Results.read(path)
+        return Results.read(folder)
 
     def _view(self, trace_id: str, run_id: str) -> str:
         if not run_id:

@@ -40,7 +40,7 @@ class ResultsSource:
 
     @classmethod
     def open(cls, path: str | Path, dataset: str | Path | None = None) -> ResultsSource:
-        """The results at ``path`` (Parquet, JSON lines or CSV) and their dataset (UserError if
+        """The results at ``path`` (a run directory, Parquet, JSON lines or CSV) and their dataset (UserError if
         none is given and the file does not lie in one)."""
         results = Results.read(path)
         root = Path(dataset).resolve() if dataset is not None else find_dataset(path)

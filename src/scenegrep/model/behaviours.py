@@ -56,6 +56,13 @@ class BehaviourLabels(RowTable):
         names = np.array(self.vocabulary, dtype=object)
         return [frozenset(names[row].tolist()) for row in self.member]
 
+    def distinct_sets(self) -> tuple[list[str], np.ndarray]:
+        """The distinct label sets (names joined by ',', '' for the empty set) and every row's
+        code into them (an int array, one per row)."""
+        names = np.array(self.vocabulary, dtype=object)
+        unique, codes = np.unique(self.member, axis=0, return_inverse=True)
+        return [",".join(names[row].tolist()) for row in unique], codes.reshape(-1)
+
     def thresholded(self, min_confidence: float) -> BehaviourLabels:
         """Keep only labels whose confidence is at least ``min_confidence`` (labels without one stay)."""
         if self.confidence is None:

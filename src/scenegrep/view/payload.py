@@ -13,7 +13,6 @@ import numpy as np
 import shapely
 
 from ..model import LabelTrace, RoadMap
-from ..model.taxonomy import kind_of
 from .data import TraceView
 from .style import MARKED_COLOUR, class_colours, program_colours
 
@@ -62,12 +61,11 @@ def _round(values: np.ndarray, digits: int = DIGITS) -> list[float | None]:
 
 
 def _objects(trace: LabelTrace) -> dict[str, list[str]]:
-    categories = trace.objects.category.tolist()
     colours = class_colours()
-    kinds = [kind_of(c) for c in categories]
+    kinds = trace.objects.kinds().tolist()
     return {
         "id": trace.objects.id.tolist(),
-        "category": categories,
+        "category": trace.objects.category.tolist(),
         "kind": kinds,
         "colour": [colours[k] for k in kinds],
     }
@@ -78,10 +76,8 @@ def _states(view: TraceView) -> dict[str, Any]:
     labels: list[str] = []
     codes: list[int] = []
     if trace.behaviours is not None and len(st):
-        vocabulary = np.asarray(trace.behaviours.vocabulary, dtype=object)
-        unique, inverse = np.unique(trace.behaviours.member, axis=0, return_inverse=True)
-        labels = [",".join(vocabulary[row].tolist()) for row in unique]
-        codes = inverse.reshape(-1).tolist()
+        labels, found = trace.behaviours.distinct_sets()
+        codes = found.tolist()
     return {
         "offsets": st.frame_offsets(trace.n_frames).tolist(),
         "object": st.object.tolist(),

@@ -15,9 +15,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import UserError
-from ..model.taxonomy import kind_of
+from ..model.geometry import box_corners
 from .data import MatchView, TraceView
 from .style import MARKED_COLOUR, class_colours, program_colours
+
+MIN_SIZE = 0.5
+"""Boxes are drawn at least this long and wide (metres), so that points and unknown sizes show."""
 
 GIF_MAX_FRAMES = 150
 """A GIF shows at most this many frames (every k-th frame of a longer stretch)."""
@@ -42,15 +45,9 @@ class Boxes:
         if view.image_space:
             return cls._image(view)
         st = view.trace.states
-        length = np.maximum(np.nan_to_num(st.length, nan=0.5), 0.5) / 2
-        width = np.maximum(np.nan_to_num(st.width, nan=0.5), 0.5) / 2
-        fx, fy = -np.sin(st.heading), np.cos(st.heading)
-        a = np.array([1, 1, -1, -1])[None, :] * length[:, None]
-        b = np.array([1, -1, -1, 1])[None, :] * width[:, None]
-        corners = np.stack(
-            [st.x[:, None] + a * fx[:, None] + b * fy[:, None], st.y[:, None] + a * fy[:, None] - b * fx[:, None]],
-            axis=2,
-        )
+        length = np.maximum(np.nan_to_num(st.length, nan=MIN_SIZE), MIN_SIZE)
+        width = np.maximum(np.nan_to_num(st.width, nan=MIN_SIZE), MIN_SIZE)
+        corners = box_corners(st.x, st.y, st.heading, length, width)
         marked = np.zeros(len(st), bool) if view.marked is None else view.marked
         return cls(st.frame, st.object, corners, np.stack([st.x, st.y], axis=1), marked)
 
@@ -271,7 +268,7 @@ def _names(view: TraceView, match: MatchView | None) -> dict[int, str]:
 
 def _kind_colours(view: TraceView) -> list[str]:
     colours = class_colours()
-    return [colours[kind_of(c)] for c in view.trace.objects.category]
+    return [colours[kind] for kind in view.trace.objects.kinds()]
 
 
 def _match_title(view: TraceView, match: MatchView) -> str:
@@ -331,9 +328,7 @@ def _label_rows(ax, view: TraceView, names: dict[int, str]) -> None:
 
     trace = view.trace
     assert trace.behaviours is not None
-    vocabulary = np.asarray(trace.behaviours.vocabulary, dtype=object)
-    unique, codes = np.unique(trace.behaviours.member, axis=0, return_inverse=True)
-    codes = codes.reshape(-1)
+    sets, codes = trace.behaviours.distinct_sets()
     palette = plt.get_cmap("tab10")
     used: dict[int, str] = {}
     for k, (row, name) in enumerate(names.items()):
@@ -341,7 +336,7 @@ def _label_rows(ax, view: TraceView, names: dict[int, str]) -> None:
         for code in np.unique(codes[mine]).tolist():
             frames = trace.states.frame[mine & (codes == code)]
             ax.broken_barh([(f, 1) for f in frames.tolist()], (k + 0.1, 0.8), color=palette(code % 10))
-            used[code] = ",".join(vocabulary[unique[code]].tolist()) or "(none)"
+            used[code] = sets[code] or "(none)"
         ax.text(1, k + 0.5, name, va="center", fontsize=8, fontweight="bold")
     ax.set_ylim(0, len(names))
     handles = [plt.Rectangle((0, 0), 1, 1, color=palette(code % 10)) for code in used]

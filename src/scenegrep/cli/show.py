@@ -68,8 +68,8 @@ def _chosen(source: Any, args: argparse.Namespace) -> tuple[str, int | None]:
         return row["trace_id"], row["match"]
     if args.trace not in source.trace_ids():
         raise UserError(f"--trace {args.trace}: the results have no such trace")
-    numbers = [r["match"] for r in source.rows_of(args.trace) if r["status"] == "match"]
-    return args.trace, (args.match if numbers else None)
+    matched = any(r["status"] == "match" for r in source.rows_of(args.trace))
+    return args.trace, (args.match if matched else None)
 
 
 def _write(view: Any, match: Any, args: argparse.Namespace) -> None:
@@ -89,7 +89,9 @@ def _write(view: Any, match: Any, args: argparse.Namespace) -> None:
 
 
 def _position(view: Any, index: int) -> int:
-    positions = {int(i): p for p, i in enumerate(view.trace.frame_index.tolist())}
+    from ..view.data import frame_positions
+
+    positions = frame_positions(view.trace)
     if index not in positions:
         raise UserError(f"--frame {index}: the trace has no frame with that index")
     return positions[index]

@@ -87,9 +87,10 @@ def build_view(
     """The view of ``trace`` with the results rows of it (the results table's columns; rows of
     other traces must be filtered out before). The map is cropped to the trace's area."""
     matches, notes = [], []
+    positions = frame_positions(trace)
     for row in rows:
         if row["status"] == "match":
-            matches.append(_match_view(trace, row))
+            matches.append(_match_view(trace, positions, row))
         elif row.get("explanation") or row.get("error"):
             notes.append(f"{row['status']}: {row.get('error') or row.get('explanation')}")
     marked, marked_boxes = _marked(trace, query) if query is not None and query.kind == "spre" else (None, None)
@@ -105,10 +106,14 @@ def build_view(
     )
 
 
-def _match_view(trace: LabelTrace, row: Mapping[str, Any]) -> MatchView:
-    position = {int(index): p for p, index in enumerate(trace.frame_index.tolist())}
+def frame_positions(trace: LabelTrace) -> dict[int, int]:
+    """The position (0..F-1) of every dataset frame index of the trace."""
+    return {index: p for p, index in enumerate(trace.frame_index.tolist())}
+
+
+def _match_view(trace: LabelTrace, positions: dict[int, int], row: Mapping[str, Any]) -> MatchView:
     try:
-        first, last = position[int(row["start_frame"])], position[int(row["end_frame"])]
+        first, last = positions[int(row["start_frame"])], positions[int(row["end_frame"])]
     except KeyError:
         raise UserError(
             f"match {row['match']} of {trace.name!r} names frames {row['start_frame']}-{row['end_frame']}, "

@@ -95,3 +95,10 @@ def test_the_page_is_self_contained_and_its_data_cannot_close_the_script():
     assert "</script><b>" not in page
     assert "http://" not in page and "https://" not in page and "src=" not in page
     assert json.loads(script_json({"q": "</script>"}))["q"] == "</script>"
+
+
+def test_a_spre_run_on_some_channels_marks_only_their_boxes():
+    car, ped = ("car", 10, 10, 4, 4), ("ped", 50, 50, 4, 4)
+    trace = image_trace([[[car, ped], [ped]], [[car], []]], channels=("front", "back"))
+    view = build_view(trace, query=QueryInfo("spre", "[[:ped:]]", {"channels": ["back"]}))
+    assert view.marked_boxes.tolist() == [False, False, True, False]

@@ -23,7 +23,7 @@ import numpy as np
 from ..lazy import lazy_import
 
 from ..errors import UserError
-from ..model import LabelTrace
+from ..model import LabelTrace, SampleTable
 from ..model.geometry import box_corners
 from ..model.taxonomy import kind_of
 from . import syntax as s
@@ -200,14 +200,19 @@ def _compare(values: np.ndarray, op: str, target: str | float) -> np.ndarray:
     return out
 
 
+def channel_samples(samples: SampleTable, channels: tuple[str, ...]) -> np.ndarray:
+    """Which samples (a boolean per row) come from one of ``channels``."""
+    wanted = [k for k, name in enumerate(samples.channels) if name in channels]
+    return np.isin(samples.channel, wanted)
+
+
 def image_space(trace: LabelTrace, channels: tuple[str, ...] | None, match_kinds: bool) -> Space:
     """The image space of a trace's detections, keeping only ``channels`` (all when None)."""
     if trace.images is None:
         raise UserError(f"trace {trace.name!r} has no image detections; use the top-down space")
     samples, boxes = trace.images.samples, trace.images.boxes
     if channels is not None:
-        wanted = [k for k, name in enumerate(samples.channels) if name in channels]
-        keep = np.isin(samples.channel, wanted)
+        keep = channel_samples(samples, channels)
         box_keep = keep[boxes.sample]
         samples = samples.take(keep)
         boxes = boxes.take(box_keep)

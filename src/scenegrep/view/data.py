@@ -171,12 +171,13 @@ def _marked(trace: LabelTrace, query: QueryInfo) -> tuple[np.ndarray | None, np.
 
 def _box_rows(trace: LabelTrace, region_mask: np.ndarray, channels: tuple[str, ...] | None) -> np.ndarray:
     """A region mask of the image space (boxes of the kept channels) as a mask over all boxes."""
+    from ..spre.space import channel_samples
+
     assert trace.images is not None
     samples, boxes = trace.images.samples, trace.images.boxes
     if channels is None:
         return region_mask
-    wanted = [k for k, name in enumerate(samples.channels) if name in channels]
-    kept = np.isin(samples.channel, wanted)[boxes.sample]
+    kept = channel_samples(samples, channels)[boxes.sample]
     out = np.zeros(len(boxes), dtype=bool)
     out[kept] = region_mask
     return out

@@ -138,10 +138,10 @@ class Figure:
             ax.autoscale_view()
         self.collection = PolyCollection([], zorder=3)
         ax.add_collection(self.collection, autolim=False)
-        paths = [self._path(row) for row in self.names]
+        paths = {name: path for row, name in self.names.items() if len(path := self._path(row)) > 1}
         self.paths = LineCollection(
-            [p for p in paths if len(p) > 1],
-            colors=[self.colours[n] for row, n in self.names.items() if len(self._path(row)) > 1],
+            list(paths.values()),
+            colors=[self.colours[name] for name in paths],
             linestyles="dashed",
             linewidths=1.5,
             alpha=0.7,

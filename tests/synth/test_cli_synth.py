@@ -92,7 +92,7 @@ def test_bad_program_is_one_line_at_line_and_column(programs, maps_dir, capsys):
     [
         (["--runs", 0], "--runs, --steps and --max-iterations must be at least 1"),
         (["--drop-frames", 1.5], "drop_frames must lie in [0, 1)"),
-        (["--map", "nowhere.xodr"], "nowhere.xodr: no such file (expected an OpenDRIVE map)"),
+        (["--map", "nowhere.xodr"], "nowhere.xodr: no such file (expected an OpenDRIVE .xodr file)"),
     ],
 )
 def test_option_errors(programs, maps_dir, capsys, args, message):

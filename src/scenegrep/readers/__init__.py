@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import UserError, at
 from ..model import LabelTrace, MapSource
+from .common import regular_file
 
 if TYPE_CHECKING:
     from ..model import RoadMap
@@ -124,9 +125,7 @@ def detect_format(path: str | Path) -> str:
         if module("trace-folder").trace_files(path):
             return "trace-folder"
         raise UserError("a directory that is neither an Argoverse 2 log or scenario nor holds trace files", at(path))
-    if not path.exists():
-        raise UserError("no such file or directory", at(path))
-    found = sniff_file(path)
+    found = sniff_file(regular_file(path, "a trace or map file, or a recording directory"))
     if found is None:
         raise UserError(f"unrecognised input format; supported: {', '.join(FORMATS)}", at(path))
     return found
@@ -171,7 +170,9 @@ def _read_map_cached(path: str, format_name: str, key: str | None) -> RoadMap:
 
 def read_map(source: MapSource | str | Path, format_name: str | None = None) -> RoadMap:
     """A road map from a :class:`MapSource` or a path (maps are cached per process: a fleet
-    of traces usually shares a few city maps)."""
-    if isinstance(source, MapSource):
-        return _read_map_cached(source.path, _checked(source.path, source.format, "map"), source.key)
-    return _read_map_cached(str(source), _checked(source, format_name, "map"), None)
+    of traces usually shares a few city maps). Every map format is a file: a path that is not
+    a regular file is a :class:`UserError`."""
+    path, key = (source.path, source.key) if isinstance(source, MapSource) else (str(source), None)
+    name = _checked(path, source.format if isinstance(source, MapSource) else format_name, "map")
+    regular_file(path, f"a road map ({name})")
+    return _read_map_cached(path, name, key)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import stat
 from pathlib import Path
 from typing import Any
 from collections.abc import Iterator, Mapping
@@ -16,6 +17,25 @@ STDIN = "-"
 def display_name(path: str | Path) -> str:
     """How a path is named in messages (``<stdin>`` for ``-``)."""
     return "<stdin>" if str(path) == STDIN else str(path)
+
+
+def regular_file(path: str | Path, what: str) -> Path:
+    """``path`` when it names a regular file (symbolic links followed), else a one-line
+    :class:`UserError` saying what it is instead and that ``what`` (e.g. "an OpenDRIVE .xodr
+    file") was expected: missing, a directory, or a device, fifo or socket (which could block
+    or never end)."""
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        raise UserError(f"no such file (expected {what})", at(path)) from None
+    except OSError as exc:
+        raise UserError(f"cannot read ({exc.strerror}; expected {what})", at(path)) from None
+    if stat.S_ISDIR(mode):
+        raise UserError(f"is a directory, expected {what}", at(path))
+    if not stat.S_ISREG(mode):
+        raise UserError(f"not a regular file (a device, fifo or socket), expected {what}", at(path))
+    return path
 
 
 def read_bytes(path: str | Path) -> bytes:

@@ -4,8 +4,13 @@ Scenic's :class:`scenic.domains.driving.roads.Network` parses the file (seconds
 for a CARLA town); the result is converted to the data model's
 :class:`~scenegrep.model.RoadMap` and cached as a Parquet map in the user cache
 (keyed by the file's SHA-256 and the Scenic version), so later loads take
-milliseconds and never import Scenic. Scenic's own ``.snet`` cache is not used:
-it would be written beside the map, which may be read-only.
+milliseconds and never import Scenic.
+
+Scenic's ``.snet`` files are pickles, and unpickling runs whatever code the file names, so
+this reader never lets Scenic near one: a map must be a regular file named ``*.xodr`` (a
+``.snet``, a file without a suffix, a directory or a fifo named as an OpenDRIVE map is a
+:class:`UserError`), and it is parsed with ``Network.fromOpenDrive``, which reads only XML
+(``Network.fromFile`` would load a ``.snet`` named by the path, or found beside it).
 
 Centrelines are Scenic's, vertex for vertex, so lane directions (the heading of the
 centreline segment a point projects onto) are exactly Scenic's ``roadDirection``; where
@@ -41,7 +46,7 @@ from ..cache import cache_dir, file_digest
 from ..errors import UserError, at
 from ..model import Area, Lane, LaneNeighbour, RoadMap
 from ..writers.trace_parquet import write_map_parquet
-from .common import reading
+from .common import reading, regular_file
 from .trace_parquet import read_map as read_cached
 
 FORMAT = "opendrive"
@@ -119,8 +124,22 @@ def convert_network(network: Any, name: str, source: str) -> RoadMap:
     )
 
 
-def _parse(path: Path) -> Any:
-    """Scenic's Network for an .xodr file (imports Scenic: about a second)."""
+def checked_xodr(path: str | Path) -> Path:
+    """``path`` when it names a regular ``.xodr`` file; a one-line :class:`UserError` otherwise
+    (in particular for Scenic's pickled ``.snet`` caches, which are never read)."""
+    path = Path(path)
+    if path.suffix.lower() != ".xodr":
+        raise UserError(
+            "not an OpenDRIVE map: expected a .xodr file (Scenic .snet caches are pickles and are never read)",
+            at(path),
+        )
+    return regular_file(path, "an OpenDRIVE .xodr file")
+
+
+def parse_network(path: Path) -> Any:
+    """Scenic's Network parsed from an .xodr file by ``Network.fromOpenDrive`` (XML only, never
+    a pickle; imports Scenic: about a second). Parse failures are :class:`UserError`\\ s."""
+    path = checked_xodr(path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         from scenic.domains.driving.roads import Network
@@ -136,7 +155,7 @@ def _parse(path: Path) -> Any:
             TypeError,
             RuntimeError,
         ):
-            return Network.fromFile(str(path), useCache=False, writeCache=False)
+            return Network.fromOpenDrive(str(path))
 
 
 def cached_map_path(path: Path) -> Path:
@@ -151,13 +170,11 @@ def read_map(path: str | Path, key: str | None = None) -> RoadMap:
 
     The cache is best effort: when it cannot be written the map is still returned.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise UserError("no such file", at(path))
+    path = checked_xodr(path)
     cached = cached_map_path(path)
     if cached.is_file():
         return replace(read_cached(cached), source=str(path))
-    road_map = convert_network(_parse(path), path.stem, str(path))
+    road_map = convert_network(parse_network(path), path.stem, str(path))
     with contextlib.suppress(OSError):
         write_map_parquet(road_map, cached)
     return road_map

@@ -2,10 +2,17 @@
 
 Shared by :mod:`.scenic_scenes` (static scenes) and :mod:`.simulate` (simulations).
 
-Scenic parses OpenDRIVE in seconds and caches the result in a ``.snet`` file beside the map. So
-that the cache is never written beside the user's file (which may be read-only), Scenic reads
-a copy of the map kept in the user cache (``scenic-maps/<digest>-scenic<version>/``), where its
-``.snet`` lands; later compiles of any program on the same map load it in a fraction of a second.
+Scenic parses OpenDRIVE in seconds and caches the result in a ``.snet`` file beside the map: a
+pickle, which runs whatever code it names when loaded. So Scenic is only ever given a copy of
+the user's ``.xodr`` inside scenegrep's per-user cache (``scenic-maps/<sha256>-scenic<version>/``,
+keyed by the map's content), beside which scenegrep itself writes the ``.snet`` (parsed from the
+copy, written aside and renamed), and Scenic may read a ``.snet`` from there only: the map
+options given to the program turn Scenic's cache writing off. A ``.snet`` beside the user's map
+is never read, and one named as the map is refused. When the cache cannot be written, Scenic
+reads the user's ``.xodr`` with its ``.snet`` cache off entirely. The program's own
+``map_options`` are replaced by these.
+
+Running a Scenic program executes its Python code: ``synth`` is for programs the user trusts.
 
 Scenic is imported inside the functions (about a second), never when this module is imported.
 """
@@ -13,6 +20,7 @@ Scenic is imported inside the functions (about a second), never when this module
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import random
 import shutil
 import traceback
@@ -30,40 +38,55 @@ from ..model.geometry import normalize_angle
 
 
 def checked_inputs(program: str | Path, map_path: str | Path) -> tuple[Path, Path]:
-    """The program and the OpenDRIVE map as paths; a missing file or a map that is not ``.xodr``
-    is a :class:`UserError`."""
-    program, map_path = Path(program), Path(map_path)
-    _check_file(program, "a Scenic program")
-    _check_file(map_path, "an OpenDRIVE map")
-    if map_path.suffix.lower() != ".xodr":
-        raise UserError("not an OpenDRIVE map: expected a .xodr file", at(map_path))
-    return program, map_path
+    """The program and the OpenDRIVE map as paths: each must be a regular file, the map a
+    ``.xodr`` (a Scenic ``.snet`` is refused); anything else is a :class:`UserError`."""
+    from ..readers.common import regular_file
+    from ..readers.opendrive import checked_xodr
+
+    return regular_file(program, "a Scenic program"), checked_xodr(map_path)
 
 
-def _check_file(path: Path, what: str) -> None:
-    if not path.is_file():
-        raise UserError(f"no such file (expected {what})", at(path))
+NO_SNET = {"useCache": False, "writeCache": False}
+"""Scenic map options under which ``Network.fromFile`` of an ``.xodr`` never touches a ``.snet``."""
 
 
 def map_params(map_path: Path) -> dict[str, Any]:
-    """The global parameters that give Scenic the map: the cached copy, or (when the cache
-    cannot be written) the map itself with Scenic's ``.snet`` cache writing turned off."""
+    """The global parameters that give Scenic the map: the cached copy, whose ``.snet`` only
+    scenegrep writes, or (when the cache cannot be written) the map itself with Scenic's
+    ``.snet`` cache off."""
     try:
-        return {"map": str(_cached_map(map_path))}
+        return {"map": str(_cached_map(map_path)), "map_options": {"useCache": True, "writeCache": False}}
     except OSError:
-        return {"map": str(map_path), "map_options": {"writeCache": False}}
+        return {"map": str(map_path), "map_options": dict(NO_SNET)}
 
 
 def _cached_map(map_path: Path) -> Path:
-    """A copy of the map in the user cache, beside which Scenic may write its ``.snet`` cache."""
+    """A copy of the map in the user cache, with the ``.snet`` scenegrep wrote beside it."""
+    from ..readers.opendrive import checked_xodr
     from ..writers.atomic import atomic_path  # the writers package imports pyarrow and shapely
 
-    folder = cache_dir() / "scenic-maps" / f"{file_digest(map_path)[:20]}-scenic{version('scenic')}"
+    folder = cache_dir() / "scenic-maps" / f"{file_digest(checked_xodr(map_path))[:20]}-scenic{version('scenic')}"
     copy = folder / f"{map_path.stem}.xodr"
     if not copy.is_file():
         with atomic_path(copy) as tmp:
             shutil.copyfile(map_path, tmp)
+    snet = copy.with_suffix(".snet")
+    if not snet.is_file():
+        with atomic_path(snet) as tmp:
+            _write_snet(copy, tmp)
     return copy
+
+
+def _write_snet(xodr: Path, target: Path) -> None:
+    """Scenic's ``.snet`` cache of an ``.xodr`` file (parsed from XML), as ``Network.fromFile``
+    with default map options accepts it: digests of the file and of the (empty) options."""
+    from scenic.core.serialization import deterministicHash
+
+    from ..readers.opendrive import parse_network
+
+    network = parse_network(xodr)
+    digest = hashlib.blake2b(xodr.read_bytes()).digest()
+    network.dumpPickle(target, digest, deterministicHash({}, digest_size=8))
 
 
 def compile_program(program: Path, params: Mapping[str, Any]) -> Any:

@@ -5,7 +5,8 @@ and the object correspondence; with ``--all`` every correspondence and every
 window start, else the first match per trace. ``--explain`` adds the witness of
 each match (per step: labels, guard values, HFSM outputs and states) and, for a
 trace without a match, the furthest frame reached and what failed there.
-``--json`` prints one JSON object per line. Traces without behaviour labels are
+``--json`` prints one JSON object per line. When no trace matches, the nearest misses of the
+initial scene at the window starts follow on stderr (:mod:`.misses`). Traces without behaviour labels are
 labelled first (``scenegrep label``'s labeller, with a note on stderr).
 ``--online`` reads scenegrep JSON trace documents (one per line) from stdin and
 reports each match as soon as its window is complete. Exit codes: 0 some trace
@@ -141,20 +142,28 @@ def run(args: argparse.Namespace) -> int:
         return _run_online(query, road_map, options, args)
     if not args.data:
         raise UserError("give DATA (trace files or directories), --dataset, or --online")
+    from .misses import MissCollector
+
     found = False
     traces = matched = 0
+    misses = MissCollector("nearest miss of the initial scene")
     for path in args.data:
         many = readers.FORMATS[readers.detect_format(path)].many
         for trace in readers.read_traces(path):
-            result = query.match(_labelled(trace, road_map, args), args.window, road_map, options)
+            labelled = _labelled(trace, road_map, args)
+            result = query.match(labelled, args.window, road_map, options)
             source = f"{path}#{trace.name}" if many else path
             for record in _records(result, source, args):
                 _print(record, args)
             traces += 1
             matched += int(result.matched)
             found |= result.matched
+            if not found:
+                misses.offer(source, lambda t=labelled: query.initial_scene(t, args.window, road_map, options))
     if not args.quiet:
         print(f"scenegrep: {matched} of {traces} traces match", file=sys.stderr)
+        if not found:
+            misses.report(args.json)
     return 0 if found else NO_MATCH
 
 

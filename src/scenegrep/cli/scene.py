@@ -4,8 +4,9 @@ Output is one line per matching frame, ``SOURCE:FRAME`` followed by the object
 correspondence and the values of the program's random variables; ``--json``
 prints one JSON object per line instead, ``--parquet FILE`` also writes the
 matches as a table. ``--explain`` adds a line for every frame that does not
-match, naming the first features no correspondence satisfied. Exit codes: 0 some
-frame matches, 1 none, 2 error.
+match, naming the first features no correspondence satisfied. When no frame matches, the
+nearest misses (:mod:`.misses`) follow on stderr. Exit codes: 0 some frame matches, 1 none,
+2 error.
 """
 
 from __future__ import annotations
@@ -133,6 +134,7 @@ def run(args: argparse.Namespace) -> int:
     from .. import readers
     from ..errors import UserError
     from ..scene import SceneOptions, load_scene
+    from .misses import MissCollector
 
     if args.dataset:
         return _run_dataset(args)
@@ -147,6 +149,7 @@ def run(args: argparse.Namespace) -> int:
     found = False
     frames = matched = 0
     notes: dict[str, int] = {}
+    misses = MissCollector()
     for path in args.data:
         many = readers.FORMATS[readers.detect_format(path)].many
         for trace in readers.read_traces(path):
@@ -156,6 +159,8 @@ def run(args: argparse.Namespace) -> int:
             frames += trace.n_frames
             matched += int(result.matched.sum())
             found |= bool(result.matched.any())
+            if not found:
+                misses.offer(source, lambda result=result: (result, None))
             for key, count in result.matches.notes.items():
                 notes[key] = notes.get(key, 0) + count
             if not args.quiet:
@@ -166,6 +171,8 @@ def run(args: argparse.Namespace) -> int:
         _write_parquet(rows, args.parquet)
     if not args.quiet:
         _notes(notes, matched, frames)
+        if not found:
+            misses.report(args.json)
     return 0 if found else NO_MATCH
 
 

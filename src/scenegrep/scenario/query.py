@@ -23,7 +23,7 @@ from ..scene.decide import Tolerance
 from ..scene.dependencies import analyse, completed_groups
 from ..scene.geometry import geometry_of
 from ..scene.match import SceneOptions
-from ..scene.query import SceneQuery, term_layers
+from ..scene.query import SceneQuery, SceneResult, term_layers
 from ..scene.resolve import Resolver
 from ..scenic.adapter import parse_program
 from ..scenic.parser import read_program
@@ -147,6 +147,21 @@ class ScenarioQuery:
             for assignment, starts in outcome.matches
         ]
         return ScenarioResult(trace, m, matches, Explainer(self, search, outcome))
+
+    def initial_scene(
+        self,
+        trace: LabelTrace,
+        window: int | str,
+        road_map: RoadMap | None = None,
+        options: ScenarioOptions | None = None,
+    ) -> tuple[SceneResult, np.ndarray]:
+        """The initial scene matched at every window start (any correspondence), and the starts
+        (frame positions); the other frames are reported as not matching."""
+        options = options or ScenarioOptions()
+        starts = np.arange(max(trace.n_frames - window_frames(window, trace) + 1, 0))
+        road_map = self.scene.map_for(trace, road_map, self.uses_map())
+        scene_options = SceneOptions(options.tolerance, visible_distance=options.visible_distance, frames=starts)
+        return self.scene.match(trace, road_map, scene_options), starts
 
 
 def window_frames(window: int | str, trace: LabelTrace) -> int:

@@ -39,7 +39,13 @@ class Tolerance:
     heading: float = 1e-6
 
     def of(self, feature: Feature) -> float:
-        return self.heading if feature.is_angle else self.position
+        """The tolerance a feature is compared with."""
+        return float(getattr(self, self.name_of(feature)))
+
+    @staticmethod
+    def name_of(feature: Feature) -> str:
+        """The name of the tolerance (a field of this class) a feature is compared with."""
+        return "heading" if feature.is_angle else "position"
 
     @classmethod
     def checked(cls, position: float, heading: float) -> Tolerance:

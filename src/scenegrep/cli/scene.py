@@ -49,24 +49,37 @@ def add_parser(subparsers: Any) -> None:
 
 def add_tolerance_arguments(parser: argparse.ArgumentParser) -> None:
     """``--map`` and the scene tolerances, shared by the Scenic query commands."""
+    from ..scene.profiles import PROFILES
+
     parser.add_argument("--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr file)")
     parser.add_argument(
-        "--tolerance-position", type=float, default=1e-6, metavar="M", help="position and size tolerance (m)"
+        "--tolerance-profile",
+        metavar="NAME",
+        help=f"tolerances measured on a dataset's labels ({', '.join(PROFILES)}; default exact); "
+        "--tolerance-position and --tolerance-heading override its values",
     )
-    parser.add_argument("--tolerance-heading", type=float, default=1e-6, metavar="RAD", help="heading tolerance (rad)")
+    parser.add_argument(
+        "--tolerance-position", type=float, metavar="M", help="position and size tolerance (m; default 1e-6)"
+    )
+    parser.add_argument("--tolerance-heading", type=float, metavar="RAD", help="heading tolerance (rad; default 1e-6)")
 
 
 def tolerance_of(args: argparse.Namespace) -> Any:
-    """The :class:`~scenegrep.scene.Tolerance` the options give (negative values are user errors)."""
-    from ..scene import Tolerance
+    """The :class:`~scenegrep.scene.Tolerance` the options give: the profile's, each given tolerance
+    instead of its value (unknown profiles and negative values are user errors)."""
+    from ..scene.profiles import tolerance_of
 
-    return Tolerance.checked(args.tolerance_position, args.tolerance_heading)
+    return tolerance_of(args.tolerance_profile, position=args.tolerance_position, heading=args.tolerance_heading)
 
 
-def tolerance_options(args: argparse.Namespace) -> dict[str, float]:
+def tolerance_options(args: argparse.Namespace) -> dict[str, Any]:
     """The tolerance options as dataset query options (checked)."""
-    tolerance = tolerance_of(args)
-    return {"tolerance_position": tolerance.position, "tolerance_heading": tolerance.heading}
+    tolerance_of(args)
+    return {
+        "tolerance_profile": args.tolerance_profile,
+        "tolerance_position": args.tolerance_position,
+        "tolerance_heading": args.tolerance_heading,
+    }
 
 
 def _value_text(values: dict[str, Any]) -> str:

@@ -46,23 +46,26 @@ RESULTS_SCHEMA = pa.schema(
 OPTIONS: dict[str, dict[str, Any]] = {
     "scenario": {
         "window": None,
-        "tolerance_position": 1e-6,
-        "tolerance_heading": 1e-6,
+        "tolerance_profile": None,
+        "tolerance_position": None,
+        "tolerance_heading": None,
         "visible_distance": None,
         "vocabulary": None,
         "all": False,
         "explain": False,
     },
     "scene": {
-        "tolerance_position": 1e-6,
-        "tolerance_heading": 1e-6,
+        "tolerance_profile": None,
+        "tolerance_position": None,
+        "tolerance_heading": None,
         "visible_distance": None,
         "exact": False,
         "explain": False,
     },
     "spre": {"compat": False, "space": None, "channels": None, "skip": 0},
 }
-"""Each kind's options and their defaults (the command-line options of the same names)."""
+"""Each kind's options and their defaults (the command-line options of the same names); a
+tolerance that is None takes the value of ``tolerance_profile`` (None: exact)."""
 
 
 @dataclass(frozen=True)
@@ -137,10 +140,14 @@ def _compile(spec: QuerySpec) -> Any:
 
 
 def _tolerance(spec: QuerySpec) -> Any:
-    """The spec's tolerances (checked when the spec was made)."""
-    from ..scene import Tolerance
+    """The spec's tolerances: its profile's, each given tolerance instead (checked when the spec was made)."""
+    from ..scene.profiles import tolerance_of
 
-    return Tolerance.checked(spec.option("tolerance_position"), spec.option("tolerance_heading"))
+    return tolerance_of(
+        spec.option("tolerance_profile"),
+        position=spec.option("tolerance_position"),
+        heading=spec.option("tolerance_heading"),
+    )
 
 
 def match_trace(spec: QuerySpec, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:

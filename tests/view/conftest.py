@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import tempfile
+import threading
+import urllib.error
+import urllib.request
 from pathlib import Path
 
 import pytest
@@ -42,6 +46,31 @@ def scenario_run(real_dataset: Path):
 def spre_run(real_dataset: Path):
     """A SpRE over the real dataset: pedestrians in every frame of a stretch."""
     return open_dataset(real_dataset).spre("[[:pedestrian:]]+", run=RunOptions(jobs=2))
+
+
+@pytest.fixture
+def server(real_dataset):
+    """A dataset server in a thread of this process (its queries run in child processes, one job)."""
+    from scenegrep.view.serve import DatasetServer
+
+    with DatasetServer(real_dataset, 0, jobs=1) as httpd:
+        thread = threading.Thread(target=httpd.serve_forever, daemon=True)
+        thread.start()
+        yield httpd
+        httpd.shutdown()
+
+
+def fetch(server, path: str, body: dict | None = None, headers: dict | None = None) -> tuple[int, bytes]:
+    """Status and body of a request to ``server`` as its own page makes it (the token, and JSON
+    for a ``body``); ``headers`` add to or (None) remove from those."""
+    sent = {"X-Scenegrep-Token": server.token} | ({} if body is None else {"Content-Type": "application/json"})
+    sent = {k: v for k, v in (sent | (headers or {})).items() if v is not None}
+    data = None if body is None else json.dumps(body).encode()
+    try:
+        with urllib.request.urlopen(urllib.request.Request(server.url + path, data, sent), timeout=120) as response:
+            return response.status, response.read()
+    except urllib.error.HTTPError as exc:
+        return exc.code, exc.read()
 
 
 @pytest.fixture(scope="session")

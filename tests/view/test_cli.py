@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import json
-import threading
-import urllib.error
-import urllib.request
 from pathlib import Path
 
 import pytest
@@ -15,8 +12,8 @@ from scenegrep.cli.main import main
 from scenegrep.dataset.results import Results
 from scenegrep.view.plot import GIF_MARGIN
 from scenegrep.view.report import view_file
-from scenegrep.view.serve import DatasetServer
 from tests.conftest import REPO
+from tests.view.conftest import fetch
 
 pytestmark = pytest.mark.real_data
 
@@ -106,42 +103,23 @@ def test_report_links_every_match_to_a_written_view(real_dataset, spre_run, tmp_
     assert f"{len(matches)} matches" in capsys.readouterr().err
 
 
-@pytest.fixture
-def server(real_dataset):
-    """A dataset server in a thread, querying in-process (one job)."""
-    with DatasetServer(real_dataset, 0, jobs=1) as httpd:
-        thread = threading.Thread(target=httpd.serve_forever, daemon=True)
-        thread.start()
-        yield httpd
-        httpd.shutdown()
-
-
-def fetch(url: str, body: dict | None = None) -> tuple[int, bytes]:
-    data = None if body is None else json.dumps(body).encode()
-    try:
-        with urllib.request.urlopen(urllib.request.Request(url, data=data), timeout=120) as response:
-            return response.status, response.read()
-    except urllib.error.HTTPError as exc:
-        return exc.code, exc.read()
-
-
 def test_serve_binds_to_the_loopback_and_answers_the_catalog(server, real_dataset):
     assert server.server_address[0] == "127.0.0.1"
-    status, body = fetch(server.url + "api/traces")
+    status, body = fetch(server, "api/traces")
     assert status == 200 and len(json.loads(body)) == 62
-    status, body = fetch(server.url)
+    status, body = fetch(server, "")
     assert status == 200 and b'id="query-form"' in body
 
 
 def test_serve_runs_queries_like_the_dataset_engine(server, spre_run):
-    status, body = fetch(server.url + "api/query", {"kind": "spre", "text": "[[:pedestrian:]]+", "options": {}})
+    status, body = fetch(server, "api/query", {"kind": "spre", "text": "[[:pedestrian:]]+", "options": {}})
     answer = json.loads(body)
     assert status == 200 and answer["run_id"] == spre_run.run_id
     assert answer["counts"] == spre_run.counts()
     assert [m["trace_id"] for m in answer["matches"]] == spre_run.matches["trace_id"].to_pylist()
-    status, page = fetch(server.url + answer["matches"][0]["href"].split("#")[0].lstrip("/"))
+    status, page = fetch(server, answer["matches"][0]["href"].split("#")[0].lstrip("/"))
     assert status == 200 and b"scenegrep-data" in page
-    status, page = fetch(server.url + answer["report"].lstrip("/"))
+    status, page = fetch(server, answer["report"].lstrip("/"))
     assert status == 200 and page.count(b'class="match-link"') == len(answer["matches"])
 
 
@@ -155,14 +133,14 @@ def test_serve_runs_queries_like_the_dataset_engine(server, spre_run):
     ],
 )
 def test_serve_answers_bad_queries_with_one_line(server, request_body, message):
-    status, body = fetch(server.url + "api/query", request_body)
+    status, body = fetch(server, "api/query", request_body)
     assert status == 400 and message in json.loads(body)["error"]
 
 
 def test_serve_answers_unknown_pages_and_runs(server):
-    assert fetch(server.url + "view/nope")[0] == 400
-    assert json.loads(fetch(server.url + "report/abc")[1])["error"] == "the dataset has no run 'abc'"
-    assert fetch(server.url + "nothing/here")[0] == 404
+    assert fetch(server, "view/nope")[0] == 400
+    assert json.loads(fetch(server, "report/abc")[1])["error"] == "the dataset has no run 'abc'"
+    assert fetch(server, "nothing/here")[0] == 404
 
 
 def test_serve_runs_a_typed_scenic_scene_like_the_api(server, real_dataset):
@@ -171,7 +149,7 @@ def test_serve_runs_a_typed_scenic_scene_like_the_api(server, real_dataset):
     program = REPO / "examples" / "scenes" / "fig3_car_ahead.scenic"
     options = {"tolerance_position": 1.0, "tolerance_heading": 0.2618}
     request = {"kind": "scene", "text": program.read_text(), "options": {**options, "explain": False}}
-    status, body = fetch(server.url + "api/query", request)
+    status, body = fetch(server, "api/query", request)
     assert status == 200
     expected = open_dataset(real_dataset).scene(program, **options)
     answer = json.loads(body)

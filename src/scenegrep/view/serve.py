@@ -1,12 +1,17 @@
 """``scenegrep serve``: a local web page over a dataset: browse its traces, type a query, run
 it with the dataset engine and open the matches in the same views as ``show`` and ``report``.
 
-The server binds to 127.0.0.1 only and answers one request at a time in the main thread (a query
-runs in the engine's worker processes while the page waits). Routes:
+The server binds to 127.0.0.1 only and answers each request in its own thread. Every request
+passes the checks of :mod:`.guard` (its ``Host``; for the API the token the page holds; for
+POSTs their ``Origin``, ``Content-Type`` and length); a request whose body does not arrive
+within :data:`READ_TIMEOUT` seconds is dropped. A query runs in a child process with a time
+limit (:mod:`.limited`), one at a time; it never compiles or runs a Scenic program with Scenic
+itself, and file options name files inside the dataset only. Routes:
 
 - ``GET /``: the page; ``GET /api/traces``: the catalog's traces; ``GET /api/runs``: past runs.
 - ``POST /api/query`` with JSON ``{"kind", "text", "options"}``: runs the query; answers the
-  run's id, status, counts and matches, or ``{"error": one line}`` with status 400.
+  run's id, status, counts and matches, or ``{"error": one line}`` with status 400 (408 past the
+  time limit, 409 while another query runs).
 - ``GET /view/TRACE_ID?run=RUN_ID``: the trace's view with the run's rows (``#match=N``).
 - ``GET /report/RUN_ID``: the report of a run, its matches linked to ``/view/...``.
 """
@@ -15,45 +20,62 @@ from __future__ import annotations
 
 import json
 import math
+import secrets
 import sys
+import threading
 from http import HTTPStatus
-from http.server import BaseHTTPRequestHandler, HTTPServer
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs, quote, unquote, urlsplit
 
 from ..dataset import Dataset
-from ..dataset.queries import QuerySpec
+from ..dataset.queries import OPTIONS, QuerySpec
 from ..dataset.results import RESULTS_FILE, Results
-from ..dataset.run import RunOptions, run_query
 from ..errors import UserError
 from .data import build_view
+from .guard import TIME_LIMIT, TOKEN_HEADER, Refused, check_host, check_post, check_token, dataset_file, public_message
+from .limited import QueryTimeout, run_limited
 from .page import asset, html_page, view_page
 from .report import report_page
 from .sources import ResultsSource, load_trace
 
 HOST = "127.0.0.1"
-MAX_BODY = 1 << 20
-"""The largest query request accepted, in bytes."""
+READ_TIMEOUT = 10.0
+"""Seconds a connection may stay silent while its request is read."""
+FILE_OPTIONS = ("vocabulary",)
+"""Query options that name files (accepted only inside the dataset)."""
 
 
-class DatasetServer(HTTPServer):
-    """An HTTP server over the dataset at ``root``; queries run with ``jobs`` workers."""
+class DatasetServer(ThreadingHTTPServer):
+    """An HTTP server over the dataset at ``root``; queries run with ``jobs`` workers for at
+    most ``time_limit`` seconds. ``token`` is the random key of its page's API calls."""
 
-    def __init__(self, root: Path, port: int = 0, jobs: int | None = None):
+    daemon_threads = True
+
+    def __init__(self, root: Path, port: int = 0, jobs: int | None = None, time_limit: float = TIME_LIMIT):
         self.dataset = Dataset(root)
         self.jobs = jobs
+        self.time_limit = time_limit
+        self.token = secrets.token_urlsafe(32)
+        self.query_lock = threading.Lock()
         super().__init__((HOST, port), Handler)
 
     @property
+    def address(self) -> str:
+        """``127.0.0.1:PORT``, the only ``Host`` answered."""
+        return f"{HOST}:{self.server_address[1]}"
+
+    @property
     def url(self) -> str:
-        return f"http://{HOST}:{self.server_address[1]}/"
+        return f"http://{self.address}/"
 
 
 class Handler(BaseHTTPRequestHandler):
     """Routes requests (see the module docstring)."""
 
     server: DatasetServer
+    timeout = READ_TIMEOUT
 
     def log_message(self, format: str, *args: Any) -> None:
         """Requests are not logged (the terminal shows only the address and errors)."""
@@ -63,8 +85,11 @@ class Handler(BaseHTTPRequestHandler):
         parts = [unquote(p) for p in url.path.strip("/").split("/")] if url.path.strip("/") else []
         query = parse_qs(url.query)
         try:
+            check_host(self.headers, self.server.address)
+            if parts[:1] == ["api"]:
+                check_token(self.headers, self.server.token)
             if not parts:
-                self._send(HTTPStatus.OK, _index_page(), "text/html")
+                self._send(HTTPStatus.OK, _index_page(self.server.token), "text/html")
             elif parts == ["api", "traces"]:
                 self._json(HTTPStatus.OK, self.server.dataset.traces().to_pylist())
             elif parts == ["api", "runs"]:
@@ -74,42 +99,62 @@ class Handler(BaseHTTPRequestHandler):
             elif len(parts) == 2 and parts[0] == "report":
                 self._send(HTTPStatus.OK, self._report(parts[1]), "text/html")
             else:
-                self._json(HTTPStatus.NOT_FOUND, {"error": f"no page {url.path}"})
+                self._error(HTTPStatus.NOT_FOUND, f"no page {url.path}")
+        except Refused as exc:
+            self._error(exc.status, exc.reason)
         except UserError as exc:
-            self._json(HTTPStatus.BAD_REQUEST, {"error": exc.one_line()})
+            self._error(HTTPStatus.BAD_REQUEST, exc.one_line())
 
     def do_POST(self) -> None:
-        if urlsplit(self.path).path != "/api/query":
-            self._json(HTTPStatus.NOT_FOUND, {"error": f"no page {self.path}"})
-            return
         try:
-            length = int(self.headers.get("Content-Length", "0"))
-            if length > MAX_BODY:
-                raise UserError("the query request is too large")
-            request = json.loads(self.rfile.read(length) or b"{}")
-            self._json(HTTPStatus.OK, self._run(request))
+            check_host(self.headers, self.server.address)
+            if urlsplit(self.path).path != "/api/query":
+                raise Refused(HTTPStatus.NOT_FOUND, f"no page {self.path}")
+            check_token(self.headers, self.server.token)
+            request = self._body(check_post(self.headers, self.server.address))
+            if not self.server.query_lock.acquire(blocking=False):
+                raise Refused(HTTPStatus.CONFLICT, "another query is running; run this one when it ends")
+            try:
+                self._json(HTTPStatus.OK, self._run(request))
+            finally:
+                self.server.query_lock.release()
+        except Refused as exc:
+            self._error(exc.status, exc.reason)
+        except QueryTimeout as exc:
+            self._error(HTTPStatus.REQUEST_TIMEOUT, str(exc))
         except UserError as exc:
-            self._json(HTTPStatus.BAD_REQUEST, {"error": exc.one_line()})
-        except (ValueError, TypeError, AttributeError) as exc:
-            self._json(HTTPStatus.BAD_REQUEST, {"error": f"bad query request: {exc}"})
+            self._error(HTTPStatus.BAD_REQUEST, exc.one_line())
+        except TimeoutError:
+            self.close_connection = True
 
     # ------------------------------------------------------------------ pages
-    def _run(self, request: dict[str, Any]) -> dict[str, Any]:
+    def _body(self, length: int) -> dict[str, Any]:
+        """The request's JSON object (its body of ``length`` bytes, read within the timeout)."""
+        data = self.rfile.read(length)
+        if len(data) < length:
+            raise Refused(HTTPStatus.BAD_REQUEST, "the request body is shorter than its Content-Length")
+        try:
+            request = json.loads(data or b"{}")
+        except ValueError as exc:
+            raise Refused(HTTPStatus.BAD_REQUEST, f"bad query request: {exc}") from None
         if not isinstance(request, dict) or not {"kind", "text"} <= set(request):
-            raise UserError("bad query request: it needs a 'kind' and a 'text'")
-        options = {k: v for k, v in dict(request.get("options") or {}).items() if v not in (None, "")}
+            raise Refused(HTTPStatus.BAD_REQUEST, "bad query request: it needs a 'kind' and a 'text'")
+        return request
+
+    def _run(self, request: dict[str, Any]) -> dict[str, Any]:
+        options = request.get("options") or {}
+        if not isinstance(options, dict):
+            raise Refused(HTTPStatus.BAD_REQUEST, "bad query request: 'options' must be an object")
+        options = {k: v for k, v in options.items() if v not in (None, "")}
+        for name in FILE_OPTIONS:
+            if name in options and name in OPTIONS.get(str(request["kind"]), {}):
+                options[name] = dataset_file(self.server.dataset.path, options[name], name)
         spec = QuerySpec.of(str(request["kind"]), str(request["text"]), "<query>", **options)
-        results = run_query(self.server.dataset.path, spec, RunOptions(jobs=self.server.jobs))
-        matches = results.matches.to_pylist()
-        for row in matches:
-            row["href"] = f"/view/{quote(row['trace_id'])}?run={results.run_id}#match={row['match']}"
-        return {
-            "run_id": results.run_id,
-            "status": results.status,
-            "counts": results.counts(),
-            "report": f"/report/{results.run_id}",
-            "matches": matches,
-        }
+        answer = run_limited(self.server.dataset.path, spec, self.server.jobs, self.server.time_limit)
+        for row in answer["matches"]:
+            if row.get("error"):
+                row["error"] = public_message(row["error"], self.server.dataset.path)
+        return answer
 
     def _results(self, run_id: str) -> Results:
         folder = self.server.dataset.path / "runs" / Path(run_id).name
@@ -135,11 +180,16 @@ class Handler(BaseHTTPRequestHandler):
         self.send_header("Content-Type", f"{content_type}; charset=utf-8")
         self.send_header("Content-Length", str(len(data)))
         self.send_header("Cache-Control", "no-store")
+        self.send_header("X-Content-Type-Options", "nosniff")
         self.end_headers()
         self.wfile.write(data)
 
     def _json(self, status: HTTPStatus, document: Any) -> None:
         self._send(status, json.dumps(_finite(document), default=str, allow_nan=False), "application/json")
+
+    def _error(self, status: HTTPStatus, message: str) -> None:
+        """``{"error": message}`` with no absolute path in it."""
+        self._json(status, {"error": public_message(message, self.server.dataset.path)})
 
 
 def _finite(value: Any) -> Any:
@@ -153,9 +203,11 @@ def _finite(value: Any) -> Any:
     return value
 
 
-def _index_page() -> str:
+def _index_page(token: str) -> str:
+    """The page, holding the server's API token (sent back in the ``X-Scenegrep-Token`` header)."""
     body = asset("serve.html").format(script=asset("serve.js"))
-    return html_page("scenegrep serve", asset("report.css") + asset("serve.css"), body)
+    attributes = {"data-token": token, "data-token-header": TOKEN_HEADER}
+    return html_page("scenegrep serve", asset("report.css") + asset("serve.css"), body, attributes)
 
 
 def _runs(dataset: Dataset) -> list[dict[str, Any]]:
@@ -164,9 +216,9 @@ def _runs(dataset: Dataset) -> list[dict[str, Any]]:
     ).to_pylist()
 
 
-def serve(root: Path, port: int, jobs: int | None) -> None:
+def serve(root: Path, port: int, jobs: int | None, time_limit: float = TIME_LIMIT) -> None:
     """Serve the dataset at ``root`` until interrupted (prints the address on stdout)."""
-    with DatasetServer(root, port, jobs) as server:
+    with DatasetServer(root, port, jobs, time_limit) as server:
         print(f"scenegrep: serving {root} at {server.url} (Ctrl-C stops)", flush=True)
         try:
             server.serve_forever()

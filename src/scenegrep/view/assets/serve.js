@@ -1,5 +1,6 @@
 // scenegrep serve: the dataset page. Lists traces and runs, sends queries to /api/query and
-// lists the matches, each linked to its view (/view/TRACE?run=RUN#match=N).
+// lists the matches, each linked to its view (/view/TRACE?run=RUN#match=N). Every API call
+// carries the token the server put on <body> (data-token), which pages elsewhere never see.
 (function () {
   "use strict";
   const $ = (id) => document.getElementById(id);
@@ -19,8 +20,9 @@
   function link(href, text) {
     const a = document.createElement("a"); a.href = href; a.textContent = text; return a;
   }
-  async function getJson(url, init) {
-    const response = await fetch(url, init);
+  async function getJson(url, init = {}) {
+    const token = { [document.body.dataset.tokenHeader]: document.body.dataset.token };
+    const response = await fetch(url, { ...init, headers: { ...(init.headers || {}), ...token } });
     const body = await response.json();
     if (!response.ok) throw new Error(body.error || response.statusText);
     return body;

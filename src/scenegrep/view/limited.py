@@ -1,0 +1,90 @@
+"""A dataset query with a time limit, for ``scenegrep serve``: the run (compile, plan, query)
+happens in a child process that leads its own process group, so that when the limit passes
+the child and every worker it started are killed at once, and the server goes on.
+
+The child is forked from a fork server (``multiprocessing``'s forkserver, which preloads this
+module), never from the threaded server itself, and works in the dataset folder, so relative
+file options (``vocabulary``) resolve there.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import os
+import signal
+from multiprocessing.connection import Connection
+from pathlib import Path
+from typing import Any
+
+from ..dataset.queries import QuerySpec
+from ..dataset.run import RunOptions, run_query
+from ..errors import UserError
+
+_CONTEXT = multiprocessing.get_context("forkserver")
+_CONTEXT.set_forkserver_preload([__name__])
+
+
+class QueryTimeout(Exception):
+    """The query ran past its time limit (and was stopped)."""
+
+
+def run_limited(root: Path, spec: QuerySpec, jobs: int | None, limit: float) -> dict[str, Any]:
+    """The run's answer (:func:`answer`) computed in a child process within ``limit`` seconds.
+
+    Raises :class:`UserError` for an error in the query, :class:`QueryTimeout` when the limit
+    passed (the child and its workers are killed), RuntimeError when the child died."""
+    receive, send = _CONTEXT.Pipe(duplex=False)
+    child = _CONTEXT.Process(target=_child, args=(send, root, spec, jobs), name="scenegrep-serve-query")
+    child.start()
+    send.close()
+    try:
+        if not receive.poll(limit):
+            raise QueryTimeout(f"the query ran longer than {limit:g} s and was stopped")
+        kind, value = receive.recv()
+    except EOFError:
+        raise RuntimeError("the query's process ended without an answer") from None
+    finally:
+        receive.close()
+        _kill_group(child.pid)
+        child.join()
+    if kind == "error":
+        raise UserError(value)
+    return value
+
+
+def _kill_group(pid: int | None) -> None:
+    """Kill the child's process group (the child, and the workers it forked); the child is not
+    yet reaped, so its group id cannot have been reused."""
+    if pid is not None:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(pid, signal.SIGKILL)
+
+
+def _child(send: Connection, root: Path, spec: QuerySpec, jobs: int | None) -> None:
+    """Run the query in the dataset folder and send ``("ok", answer)`` or ``("error", line)``."""
+    os.setsid()
+    os.chdir(root)
+    try:
+        message: tuple[str, Any] = ("ok", answer(run_query(root, spec, RunOptions(jobs=jobs))))
+    except UserError as exc:
+        message = ("error", exc.one_line())
+    send.send(message)
+    send.close()
+
+
+def answer(results: Any) -> dict[str, Any]:
+    """What the page gets of a run: its id, status, counts, report link and matches (each
+    with the link of its view)."""
+    from urllib.parse import quote
+
+    matches = results.matches.to_pylist()
+    for row in matches:
+        row["href"] = f"/view/{quote(row['trace_id'])}?run={results.run_id}#match={row['match']}"
+    return {
+        "run_id": results.run_id,
+        "status": results.status,
+        "counts": results.counts(),
+        "report": f"/report/{results.run_id}",
+        "matches": matches,
+    }

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from scenegrep.cli.main import main
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
-from scenegrep.scene.misses import SLACK, MissLimits, NearestMisses, nearest_miss, round_up
+from scenegrep.scene.misses import SLACK, MissLimits, NearestMisses, nearest_miss, rounded
 from tests.scene.frames import HEADER, MAP, ahead, right, trace_of
 
 AT = compile_scene(HEADER + "ego = new Car at (2, 30), facing 0.3, with regionContainedIn None\n")
@@ -91,11 +91,12 @@ def test_misses_are_kept_nearest_first_and_traces_past_the_limit_counted():
     assert "3 traces" in misses.summary() and "1 more traces not examined" in misses.summary()
 
 
-@pytest.mark.parametrize("value", [0.08007, 1e-6, 3.064, 0.123456, 7.0, 1.0000001])
-def test_round_up_gives_four_digits_never_less(value):
-    rounded = round_up(value)
-    assert rounded >= value and float(f"{rounded:.4g}") == rounded
-    assert rounded - value < 10 ** (math.floor(math.log10(value)) - 3) * 1.0001
+@pytest.mark.parametrize("value", [0.08007, 1e-6, 3.064, 0.123456, 7.0, 1.0000001, 0.1 + 1e-12])
+@pytest.mark.parametrize("up", [True, False])
+def test_rounding_gives_four_digits_on_the_asked_side(value, up):
+    found = rounded(value, up)
+    assert (found >= value if up else found <= value) and float(f"{found:.4g}") == found
+    assert abs(found - value) < 10 ** (math.floor(math.log10(value)) - 3) * 1.0001
 
 
 @pytest.mark.real_data

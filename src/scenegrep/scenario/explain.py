@@ -7,14 +7,20 @@ For a non-match: the first reason in pipeline order (trace too short, no candida
 of a class, no candidate whose own behaviour fits, no injective assignment) or,
 after the search, the correspondence that got furthest, the frame where its run
 died and the object whose observed label its HFSM could not produce there; or,
-when the behaviours fit somewhere, that the initial scene fails at every start.
+when the behaviours fit somewhere, that the initial scene fails at every start, and at the
+start nearest to holding (:func:`scenegrep.scene.misses.nearest_miss`) the program object, its
+label object, the features that fail and the tolerances that would admit them.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from ..scene.misses import nearest_miss, spread
+from ..scene.query import SceneResult
 
 from .automaton import DEAD, INITIAL
 from .hfsm import CAN_FALSE, CAN_TRUE
@@ -30,8 +36,17 @@ _GUARD_TEXT = {CAN_TRUE: "true", CAN_FALSE: "false", CAN_TRUE | CAN_FALSE: "true
 class Explainer:
     """Builds the explanations of one search (lazily: nothing is computed unless asked)."""
 
-    def __init__(self, query: ScenarioQuery, search: Search, outcome: Outcome):
+    def __init__(
+        self,
+        query: ScenarioQuery,
+        search: Search,
+        outcome: Outcome,
+        scene_at: Callable[[dict[str, str], np.ndarray], SceneResult],
+    ):
+        """``scene_at(correspondence, starts)`` matches the initial scene at some window starts
+        with a (partial) correspondence, program object -> label object id."""
         self.query = query
+        self.scene_at = scene_at
         self.search = search
         self.outcome = outcome
         self.trace = search.obs.trace
@@ -120,12 +135,27 @@ class Explainer:
             assignment, starts = out.scene_failures[0]
             return (
                 f"the behaviours match from {len(starts)} window start(s) with {self._names(assignment)}, "
-                f"but the initial scene holds at none of them (first: {self.frame(int(starts[0]))})"
+                f"but the initial scene holds at none of them; {self._scene_failure(assignment, starts)}"
             )
         best = out.best
         if best is None:
             return "no correspondence was found"
         return self._died(best.assignment, best.per_object, best.reach)
+
+    def _scene_failure(self, assignment: Assignment, starts: np.ndarray) -> str:
+        """Where the initial scene comes nearest to holding (else at the first start): the frame,
+        the program and label objects of the group that fails there, its features, and the
+        tolerances that would admit it."""
+        ids = self.trace.objects.id
+        result = self.scene_at({name: str(ids[row]) for name, row in assignment.items()}, starts)
+        miss = nearest_miss(result, spread(starts))
+        start = int(starts[0]) if miss is None else miss.position
+        matches = result.matches
+        group = matches.groups[int(matches.failed_group[start])]
+        correspondence = {**(miss.correspondence if miss else {}), **result.options.correspondence}
+        names = ", ".join(f"{name} = {correspondence.get(name, 'no label object')}" for name in sorted(group.objects))
+        text = f"at {self.frame(start)}, with {names}, it fails {group.describe()}"
+        return text if miss is None else f"{text}: {miss.shortfalls()}"
 
     def _furthest_unary(self, obj: str) -> str:
         cands = self.outcome.candidates[obj]

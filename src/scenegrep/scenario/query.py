@@ -22,7 +22,7 @@ from ..model import LabelTrace, RoadMap
 from ..scene.decide import Tolerance
 from ..scene.dependencies import analyse, completed_groups
 from ..scene.geometry import geometry_of
-from ..scene.match import SceneOptions
+from ..scene.match import SceneOptions, labels_of, match_trace
 from ..scene.query import SceneQuery, SceneResult, term_layers
 from ..scene.resolve import Resolver
 from ..scenic.adapter import parse_program
@@ -139,6 +139,16 @@ class ScenarioQuery:
             )
             return starts[self.scene.frames_matching(trace, geometry, scene_options, decided)[starts]]
 
+        def scene_at(correspondence: dict[str, str], starts: np.ndarray) -> SceneResult:
+            scene_options = SceneOptions(
+                options.tolerance,
+                visible_distance=options.visible_distance,
+                correspondence=correspondence,
+                frames=starts,
+            )
+            matches = match_trace(self.scene.program, groups, trace, geometry, scene_options)
+            return SceneResult(trace, self.scene, matches, labels_of(trace), geometry, scene_options)
+
         kinds = {name: objects[name].kinds for name in self.hfsms}
         search = Search(self.hfsms, kinds, self.guards, automata, obs, m, scene_starts, options.find_all)
         outcome: Outcome = search.run()
@@ -146,7 +156,7 @@ class ScenarioQuery:
             ScenarioMatch({name: str(ids[row]) for name, row in assignment.items()}, starts)
             for assignment, starts in outcome.matches
         ]
-        return ScenarioResult(trace, m, matches, Explainer(self, search, outcome))
+        return ScenarioResult(trace, m, matches, Explainer(self, search, outcome, scene_at))
 
     def initial_scene(
         self,

@@ -9,9 +9,10 @@ frames of a trace at once, each step one run of the matcher (:func:`.match.match
    ``CAPS[f]``), and ``s`` is bisected on a log scale up to ``RAY_CAP``; the frames still admitted at
    the smallest ``s`` are the trace's nearest, the first of them its nearest miss.
 2. *Refinement*: for that frame, each tolerance in turn is bisected down towards the user's value
-   with the others fixed, to a relative ``PRECISION``, and rounded up to ``DIGITS`` significant
-   digits. The result admits the frame, and lowering any one of its values by ``SLACK`` does not
-   (lowering a value refined later only makes an earlier one harder to meet).
+   with the others fixed, to a relative ``PRECISION``, and rounded to ``DIGITS`` significant
+   digits (down when that still admits the frame, else up). The result admits the frame, and
+   lowering any one of its values by ``SLACK`` does not (lowering a value refined later only makes
+   an earlier one harder to meet).
 
 Bounded: at most ``MissLimits.frames`` evenly spaced frames of a trace and ``MissLimits.traces``
 traces are examined, each with about 15 + 20 per raised tolerance runs of the matcher.
@@ -105,9 +106,13 @@ class NearestMiss:
     def text(self) -> str:
         """One line: where, with which correspondence, what is off and the options that admit it."""
         pairs = ", ".join(f"{name}={label}" for name, label in self.correspondence.items())
+        return f"{self.source} frame {self.frame} ({pairs}): {self.shortfalls()}"
+
+    def shortfalls(self) -> str:
+        """What is off, and the options that would admit it."""
         offs = "; ".join(s.text() for s in self.needed)
         options = " ".join(s.option() for s in self.needed)
-        return f"{self.source} frame {self.frame} ({pairs}): {offs} ({options} would admit it)"
+        return f"{offs} ({options} would admit it)"
 
 
 class Probe:
@@ -130,6 +135,13 @@ class Probe:
         return frames[self.run(tolerance, frames).matched[frames]]
 
 
+def spread(frames: np.ndarray, limit: int = MissLimits.frames) -> np.ndarray:
+    """At most ``limit`` of ``frames``, evenly spaced (all when there are no more)."""
+    if len(frames) <= limit:
+        return frames
+    return frames[np.unique(np.linspace(0, len(frames) - 1, limit).round().astype(np.intp))]
+
+
 def raised(base: Tolerance, s: float) -> Tolerance:
     """The ray's tolerances at parameter ``s`` (see the module docstring)."""
     return replace(
@@ -137,15 +149,20 @@ def raised(base: Tolerance, s: float) -> Tolerance:
     )
 
 
-def round_up(value: float) -> float:
-    """The smallest number of ``DIGITS`` significant decimal digits that is at least ``value``
-    (as the float its decimal text parses to, so the printed option is the value tested)."""
+def rounded(value: float, up: bool = True) -> float:
+    """The nearest number of ``DIGITS`` significant decimal digits at least (``up``) or at most
+    ``value``, as the float its decimal text parses to (so a printed option is the value tested)."""
     if value <= 0:
         return value
     exponent = math.floor(math.log10(value)) - DIGITS + 1
-    digits = math.ceil(value / 10.0**exponent)
-    rounded = float(f"{digits}e{exponent}")
-    return rounded if rounded >= value else float(f"{digits + 1}e{exponent}")
+    scaled = value / 10.0**exponent
+    digits = math.ceil(scaled) if up else math.floor(scaled)
+    found = float(f"{digits}e{exponent}")
+    if up and found < value:
+        return float(f"{digits + 1}e{exponent}")
+    if not up and found > value:
+        return float(f"{digits - 1}e{exponent}")
+    return found
 
 
 def nearest_miss(
@@ -193,8 +210,8 @@ def _ray(probe: Probe, base: Tolerance, frames: np.ndarray, ray_cap: float) -> t
 
 
 def _refined(probe: Probe, base: Tolerance, tolerance: Tolerance, name: str, at: np.ndarray) -> Tolerance:
-    """``tolerance`` with tolerance ``name`` lowered to the smallest value (rounded up) that still
-    admits the frame ``at``, never below the user's value in ``base``."""
+    """``tolerance`` with tolerance ``name`` lowered to the smallest value (of ``DIGITS`` significant
+    digits) that still admits the frame ``at``, never below the user's value in ``base``."""
     floor, value = getattr(base, name), getattr(tolerance, name)
     if value <= floor:
         return tolerance
@@ -208,7 +225,10 @@ def _refined(probe: Probe, base: Tolerance, tolerance: Tolerance, name: str, at:
             high = middle
         else:
             low = middle
-    return replace(tolerance, **{name: min(round_up(high), value)})
+    down = replace(tolerance, **{name: rounded(high, up=False)})
+    if getattr(down, name) > floor and len(probe.admitted(down, at)):
+        return down
+    return replace(tolerance, **{name: min(rounded(high), value)})
 
 
 def _blame(probe: Probe, tolerance: Tolerance, name: str, at: np.ndarray, correspondence: dict[str, str]) -> list[str]:
@@ -247,8 +267,7 @@ class NearestMisses:
             return None
         self.traces += 1
         frames = np.arange(result.trace.n_frames) if frames is None else np.asarray(frames, dtype=np.intp)
-        if len(frames) > self.limits.frames:
-            frames = frames[np.unique(np.linspace(0, len(frames) - 1, self.limits.frames).round().astype(np.intp))]
+        frames = spread(frames, self.limits.frames)
         self.frames += len(frames)
         if not len(frames):
             return None

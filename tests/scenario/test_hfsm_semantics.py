@@ -36,7 +36,7 @@ import numpy as np
 from hypothesis import assume, event, given, settings
 from hypothesis import strategies as st
 
-from scenegrep.scenario.automaton import DEAD, INITIAL, Automaton, encode
+from scenegrep.scenario.automaton import DEAD, INITIAL, Automaton, OverBudget, encode
 from scenegrep.scenario.hfsm import (
     BOTH,
     CAN_FALSE,
@@ -53,13 +53,13 @@ from scenegrep.scenario.hfsm import (
     TryInterrupt,
 )
 from scenegrep.scenario.query import compile_scenario
-from scenegrep.scenario.windows import reach
+from scenegrep.scenario.simulate import simulate_reach
+from scenegrep.scenario.windows import table_reach
 
 STATIONARY = "Stationary"
 PERIOD = 0.1
 N_GUARDS = 2
 LABELS = ("A", "B", "C")
-TABLE_BUDGET = 5000
 
 # --------------------------------------------------------------------------------------------------
 # The reference interpreter
@@ -423,22 +423,8 @@ def scenic_outputs(tree, masks: list[tuple[int, ...]], folder) -> tuple[str, ...
 # --------------------------------------------------------------------------------------------------
 
 
-class OverBudget(Exception):
-    """The DFA took more configuration steps than its budget."""
-
-
-class BudgetedAutomaton(Automaton):
-    """An Automaton that raises :class:`OverBudget` once it has stepped ``budget`` configurations (None:
-    no limit), to keep the tests quick."""
-
-    budget: int | None = None
-
-    def outcomes(self, state, symbol):
-        if self.budget is not None:
-            self.budget -= len(self.sets[state])
-            if self.budget < 0:
-                raise OverBudget
-        return super().outcomes(state, symbol)
+STATE_BUDGET = 300
+"""The DFA states a test builds at most (nested tries can have thousands of hundreds of configurations)."""
 
 
 def agrees(sequence: tuple[str, ...], observed: list[set[str]], k: int) -> bool:
@@ -457,9 +443,9 @@ def test_hfsm_outputs_equal_the_reference(tree, masks):
 @given(data=st.data(), tree=behaviours(), masks=guard_masks)
 def test_automaton_and_windows_agree_with_the_reference(data, tree, masks):
     """The lazy DFA survives k steps iff some reference run shows the observed labels for its first k
-    steps, and windows.reach gives every start frame the survival length of the reference restarted
-    there (capped). (The windows are not checked when building the DFA table over the frames' symbols
-    takes more than TABLE_BUDGET configuration steps: too long.)
+    steps; the simulation of configuration sets (the DFA's fallback) and windows.reach over the DFA's
+    table give every start frame the survival length of the reference restarted there (capped). (The
+    table is not checked when it needs more than STATE_BUDGET states.)
     """
     hfsm = to_hfsm(tree)
     outputs = hfsm.outputs()
@@ -470,7 +456,7 @@ def test_automaton_and_windows_agree_with_the_reference(data, tree, masks):
 
     guard_codes = [np.array([mask[g] for mask in masks]) for g in hfsm.guards]
     symbols = encode(np.array(label_masks), guard_codes, len(outputs))
-    automaton = BudgetedAutomaton(hfsm, N_GUARDS, PERIOD)
+    automaton = Automaton(hfsm, N_GUARDS, PERIOD, STATE_BUDGET)
 
     prefixes = reference_prefixes(tree, masks)
     state = INITIAL
@@ -479,19 +465,16 @@ def test_automaton_and_windows_agree_with_the_reference(data, tree, masks):
         expected = any(len(prefix) == k and agrees(prefix, observed, k) for prefix in prefixes)
         assert (state != DEAD) == expected, f"step {k}: observed {observed[:k]}, reference {sorted(prefixes)}"
 
-    unique, column = np.unique(symbols, return_inverse=True)
-    automaton.budget = TABLE_BUDGET
-    try:
-        table = automaton.table(unique)
-    except OverBudget:  # nested tries can have thousands of DFA states of hundreds of configurations
-        event("the DFA table is too large to check the windows")
-        return
-    step = np.ascontiguousarray(table[:, column].T)
-    survived = reach(step, INITIAL, cap)
+    expected = []
     for i in range(n):
         suffix = reference_prefixes(tree, masks[i:])
-        longest = max(len(p) for p in suffix if len(p) <= cap and agrees(p, observed[i:], len(p)))
-        assert survived[i] == longest, f"start {i}"
+        expected.append(max(len(p) for p in suffix if len(p) <= cap and agrees(p, observed[i:], len(p))))
+    assert simulate_reach(automaton, symbols[None], cap)[0].tolist() == expected
+
+    try:
+        assert table_reach(automaton, symbols[None], cap)[0].tolist() == expected
+    except OverBudget:
+        event("the DFA table is over its budget: only the simulation is checked")
 
 
 @settings(max_examples=60, deadline=None)

@@ -22,8 +22,7 @@ import numpy as np
 from ..scene.misses import nearest_miss, spread
 from ..scene.query import SceneResult
 
-from .automaton import DEAD, INITIAL
-from .hfsm import CAN_FALSE, CAN_TRUE
+from .hfsm import CAN_FALSE, CAN_TRUE, Config
 from .search import Assignment, Outcome, Search
 from .vocabulary import STATIONARY
 
@@ -68,17 +67,17 @@ class Explainer:
         rows = self.trace.objects.row_of()
         return {name: rows[label] for name, label in correspondence.items()}
 
-    def run(self, obj: str, assignment: Assignment, start: int, steps: int) -> list[tuple[int, set, list[int]]]:
-        """Per step from ``start``: (symbol, possible outputs, DFA state after pruning)."""
+    def run(self, obj: str, assignment: Assignment, start: int, steps: int) -> list[tuple[int, set, frozenset]]:
+        """Per step from ``start``: (symbol, possible outputs, configurations kept after pruning)."""
         automaton = self.search.automata[obj]
         symbols = self.search.symbols(obj, [assignment])[0]
-        state = INITIAL
+        configs: frozenset[Config] = frozenset({None})
         found = []
         for t in range(start, min(start + steps, len(symbols))):
-            outputs = {o.label for _, o in automaton.outcomes(state, int(symbols[t]))}
-            state = automaton.next(state, int(symbols[t]))
-            found.append((int(symbols[t]), outputs, state))
-            if state == DEAD:
+            outputs = automaton.outputs_from(configs, int(symbols[t]))
+            configs = automaton.step_set(configs, int(symbols[t]))
+            found.append((int(symbols[t]), outputs, configs))
+            if not configs:
                 break
         return found
 
@@ -94,10 +93,9 @@ class Explainer:
             position = start + step
             lines.append(f"step {step}, {self.frame(position)}:")
             for obj, hfsm in self.query.hfsms.items():
-                symbol, outputs, state = runs[obj][step]
-                automaton = self.search.automata[obj]
+                symbol, outputs, configs = runs[obj][step]
                 guards = self._guard_values(obj, symbol)
-                kept = sorted({hfsm.path(c) for c in automaton.sets[state]})
+                kept = sorted({hfsm.path(c) for c in configs})
                 lines.append(
                     f"  {obj} ({correspondence[obj]}): label {self.labels_at(assignment[obj], position)}"
                     f"{guards}; HFSM outputs {{{', '.join(sorted(outputs))}}}; states: {' | '.join(kept)}"

@@ -27,7 +27,7 @@ from ..scene.query import SceneQuery, SceneResult, term_layers
 from ..scene.resolve import Resolver
 from ..scenic.adapter import parse_program
 from ..scenic.parser import read_program
-from .automaton import Automaton
+from .automaton import MAX_STATES, Automaton
 from .explain import Explainer
 from .hfsm import Hfsm
 from .observations import Observations
@@ -90,6 +90,8 @@ class ScenarioQuery:
     hfsms: dict[str, Hfsm]
     guards: list[Guard]
     vocabulary: Vocabulary
+    state_budget: int = MAX_STATES
+    """Per HFSM, the most DFA states before its windows are simulated on configuration sets instead."""
     _automata: dict[tuple[str, float], Automaton] = field(default_factory=dict)
 
     def uses_map(self) -> bool:
@@ -101,7 +103,7 @@ class ScenarioQuery:
         for name, hfsm in self.hfsms.items():
             key = (name, round(period, 9))
             if key not in self._automata:
-                self._automata[key] = Automaton(hfsm, len(self.guards), period)
+                self._automata[key] = Automaton(hfsm, len(self.guards), period, self.state_budget)
             found[name] = self._automata[key]
         return found
 

@@ -27,12 +27,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .automaton import INITIAL, Automaton, encode
+from .automaton import Automaton, OverBudget, encode
 from .hfsm import BOTH, Hfsm
 from .matching import maximum_matching
 from .observations import Observations
+from .simulate import simulate_reach
 from .translate import Guard
-from .windows import reach
+from .windows import table_reach
 
 Assignment = dict[str, int]
 """Program object -> label object index (row of the trace's object table)."""
@@ -122,14 +123,16 @@ class Search:
         return encode(masks, codes, len(automaton.outputs))
 
     def _compute(self, obj: str, assignments: list[Assignment]) -> np.ndarray:
+        """Reach per assignment and start: by the DFA's table, or by simulating configuration sets
+        when the DFA is over its state budget or its step tables too large (:func:`.windows.table_reach`)."""
         symbols = self.symbols(obj, assignments)
-        unique, inverse = np.unique(symbols, return_inverse=True)
-        table = self.automata[obj].table(unique)
-        k, n = symbols.shape
-        step = np.zeros((k, n + 1, table.shape[0]), dtype=table.dtype)
-        step[:, :n] = np.transpose(table[:, inverse.reshape(k, n)], (1, 2, 0))
-        lengths = reach(step.reshape(k * (n + 1), -1), INITIAL, self.m).reshape(k, n + 1)
-        return lengths[:, : self.n_starts]
+        automaton = self.automata[obj]
+        if not automaton.over_budget:
+            try:
+                return table_reach(automaton, symbols, self.m)[:, : self.n_starts]
+            except OverBudget:
+                pass
+        return simulate_reach(automaton, symbols, self.m)[:, : self.n_starts]
 
     # ---------------------------------------------------------------- the search
     def run(self) -> Outcome:

@@ -14,7 +14,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .automaton import DEAD
+from .automaton import DEAD, INITIAL, Automaton, OverBudget
+
+MAX_CELLS = 1 << 26
+"""At most this many DFA states x frames x doubling levels in :func:`table_reach` (256 MB of int32)."""
 
 
 def reach(step: np.ndarray, initial: int, cap: int) -> np.ndarray:
@@ -43,3 +46,18 @@ def reach(step: np.ndarray, initial: int, cap: int) -> np.ndarray:
         position[can] += block
         length[can] += block
     return length
+
+
+def table_reach(automaton: Automaton, symbols: np.ndarray, cap: int) -> np.ndarray:
+    """(k, n) per row of ``symbols`` (k, n) and start frame, the frames (at most ``cap``) survived
+    from INITIAL, by :func:`reach` over the DFA's table, all rows at once (laid end to end with a
+    dead frame between them). Raises :class:`.automaton.OverBudget` when the DFA is over its state
+    budget or the doubling tables would hold more than :data:`MAX_CELLS` states."""
+    unique, inverse = np.unique(symbols, return_inverse=True)
+    table = automaton.table(unique)
+    k, n = symbols.shape
+    if k * (n + 1) * table.shape[0] * min(cap, n).bit_length() > MAX_CELLS:
+        raise OverBudget(f"the step tables of {automaton.hfsm.obj} would be too large")
+    step = np.zeros((k, n + 1, table.shape[0]), dtype=table.dtype)
+    step[:, :n] = np.transpose(table[:, inverse.reshape(k, n)], (1, 2, 0))
+    return reach(step.reshape(k * (n + 1), -1), INITIAL, cap).reshape(k, n + 1)[:, :n]

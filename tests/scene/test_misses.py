@@ -88,7 +88,15 @@ def test_misses_are_kept_nearest_first_and_traces_past_the_limit_counted():
     for dx in (0.5, 0.1, 0.3, 0.01):
         misses.add(AT.match(trace_of({"ego": ("Car", 2 + dx, 30, 0.3)}), MAP, SceneOptions()), source=f"dx={dx}")
     assert [m.source for m in misses.found] == ["dx=0.1", "dx=0.3"]
-    assert "3 traces" in misses.summary() and "1 more traces not examined" in misses.summary()
+    assert "3 trace(s)" in misses.summary() and "1 more trace(s) not examined" in misses.summary()
+
+
+def test_a_trace_where_the_scene_holds_is_counted_not_searched():
+    misses = NearestMisses()
+    result = AT.match(trace_of({"ego": ("Car", 2, 30, 0.3)}, {"ego": ("Car", 3, 30, 0.3)}), MAP, SceneOptions())
+    assert misses.add(result, np.array([1])) is not None and misses.holding == 0
+    assert misses.add(result) is None and misses.holding == 1
+    assert "the scene holds in 1 of them" in misses.summary()
 
 
 @pytest.mark.parametrize("value", [0.08007, 1e-6, 3.064, 0.123456, 7.0, 1.0000001, 0.1 + 1e-12])

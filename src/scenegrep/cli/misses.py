@@ -37,16 +37,7 @@ class MissCollector:
         """Search the kept traces and print the nearest misses and what was examined."""
         misses = NearestMisses(self.limits, skipped=self.seen - len(self.pending))
         for source, scene_at in self.pending:
-            result, frames = scene_at()
-            holds = int(result.matched.sum())
-            if holds:
-                print(
-                    f"scenegrep: {source}: the initial scene holds at {holds} window starts; "
-                    "the behaviours fail there (--explain says where)",
-                    file=sys.stderr,
-                )
-                continue
-            misses.add(result, frames, source)
+            misses.add(*scene_at(), source)
         for miss in misses.found:
             print(f"scenegrep: {self.what}: {miss.text()}", file=sys.stderr)
             if as_json:

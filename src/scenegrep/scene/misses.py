@@ -249,13 +249,16 @@ def _blame(probe: Probe, tolerance: Tolerance, name: str, at: np.ndarray, corres
 @dataclass
 class NearestMisses:
     """The nearest misses over the traces of a query that matched nothing, nearest first: at most
-    one per trace, ``limits.kept`` in all; traces past ``limits.traces`` are counted, not examined."""
+    one per trace, ``limits.kept`` in all; traces past ``limits.traces`` are counted, not examined,
+    and so are traces where the scene already holds at a frame given (a scenario's initial scene
+    can hold where its behaviours fail)."""
 
     limits: MissLimits = field(default_factory=MissLimits)
     found: list[NearestMiss] = field(default_factory=list)
     traces: int = 0
     frames: int = 0
     skipped: int = 0
+    holding: int = 0
 
     def add(
         self, result: SceneResult, frames: np.ndarray | None = None, source: str | None = None
@@ -267,6 +270,9 @@ class NearestMisses:
             return None
         self.traces += 1
         frames = np.arange(result.trace.n_frames) if frames is None else np.asarray(frames, dtype=np.intp)
+        if result.matched[frames].any():
+            self.holding += 1
+            return None
         frames = spread(frames, self.limits.frames)
         self.frames += len(frames)
         if not len(frames):
@@ -280,13 +286,18 @@ class NearestMisses:
     def summary(self) -> str:
         """What was examined, and the bounds."""
         text = (
-            f"nearest misses searched in {self.frames} frames of {self.traces} traces "
+            f"nearest misses searched in {self.frames} frames of {self.traces} trace(s) "
             f"(at most {self.limits.frames} frames per trace, {self.limits.traces} traces, tolerances up to "
             + ", ".join(f"{name} {cap:.4g} {UNITS[name]}" for name, cap in CAPS.items())
             + ")"
         )
         if self.skipped:
-            text += f"; {self.skipped} more traces not examined"
+            text += f"; {self.skipped} more trace(s) not examined"
+        if self.holding:
+            text += (
+                f"; the scene holds in {self.holding} of them (a scenario's behaviours fail there: "
+                "--explain says where)"
+            )
         if not self.found:
             text += "; none is admitted within those tolerances"
         return text

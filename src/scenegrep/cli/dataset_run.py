@@ -65,12 +65,24 @@ def run_dataset(args: argparse.Namespace, kind: str, query: str, origin: str, op
     if not quiet:
         _print(results, args)
         _summary(results, Path(args.dataset))
+        if kind != "spre" and not results.counts()["matched"]:
+            _misses(spec, results, Path(args.dataset).resolve(), args)
     counts = results.counts()
     if results.status == "interrupted":
         return EXIT_INTERRUPTED
     if counts["failed"]:
         return EXIT_SOME_FAILED
     return 0 if counts["matched"] else NO_MATCH
+
+
+def _misses(spec: Any, results: Any, root: Any, args: argparse.Namespace) -> None:
+    """The nearest misses of a Scenic query that matched nothing in the dataset at ``root``."""
+    from ..dataset.misses import nearest_misses
+    from ..view.sources import load_trace
+    from .misses import print_misses, what_of
+
+    misses = nearest_misses(spec, results.table.to_pylist(), lambda trace_id: load_trace(root, trace_id))
+    print_misses(misses, what_of(spec.kind), args.json)
 
 
 def _report_plan(plan: Any) -> None:

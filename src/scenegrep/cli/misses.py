@@ -38,8 +38,19 @@ class MissCollector:
         misses = NearestMisses(self.limits, skipped=self.seen - len(self.pending))
         for source, scene_at in self.pending:
             misses.add(*scene_at(), source)
-        for miss in misses.found:
-            print(f"scenegrep: {self.what}: {miss.text()}", file=sys.stderr)
-            if as_json:
-                sys.stdout.write(json.dumps(miss.record()) + "\n")
-        print(f"scenegrep: {misses.summary()}", file=sys.stderr)
+        print_misses(misses, self.what, as_json)
+
+
+def print_misses(misses: NearestMisses, what: str, as_json: bool) -> None:
+    """Each miss on stderr as ``scenegrep: WHAT: ...`` (and as a JSON record on stdout with
+    ``as_json``), then what was examined."""
+    for miss in misses.found:
+        print(f"scenegrep: {what}: {miss.text()}", file=sys.stderr)
+        if as_json:
+            sys.stdout.write(json.dumps(miss.record()) + "\n")
+    print(f"scenegrep: {misses.summary()}", file=sys.stderr)
+
+
+def what_of(kind: str) -> str:
+    """How a miss's line starts for a query kind."""
+    return "nearest miss of the initial scene" if kind == "scenario" else "nearest miss"

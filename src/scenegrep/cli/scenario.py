@@ -142,11 +142,11 @@ def run(args: argparse.Namespace) -> int:
         return _run_online(query, road_map, options, args)
     if not args.data:
         raise UserError("give DATA (trace files or directories), --dataset, or --online")
-    from .misses import MissCollector
+    from .misses import MissCollector, what_of
 
     found = False
     traces = matched = 0
-    misses = MissCollector("nearest miss of the initial scene")
+    misses = MissCollector(what_of("scenario"))
     for path in args.data:
         many = readers.FORMATS[readers.detect_format(path)].many
         for trace in readers.read_traces(path):

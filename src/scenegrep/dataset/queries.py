@@ -91,7 +91,7 @@ class QuerySpec:
             raise UserError("scenario queries need a window (frames, seconds such as '5s', or 'all')")
         spec = cls(kind, text, origin, tuple(sorted(merged.items())))
         if kind != "spre":
-            _tolerance(spec)
+            spec_tolerance(spec)
         return spec
 
     @classmethod
@@ -139,7 +139,7 @@ def _compile(spec: QuerySpec) -> Any:
     return compile_scenario(spec.text, spec.origin, vocabulary, spec.option("visible_distance"))
 
 
-def _tolerance(spec: QuerySpec) -> Any:
+def spec_tolerance(spec: QuerySpec) -> Any:
     """The spec's tolerances: its profile's, each given tolerance instead (checked when the spec was made)."""
     from ..scene.profiles import tolerance_of
 
@@ -186,7 +186,7 @@ def _spre_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap
 def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
     from ..scene import SceneOptions
 
-    options = SceneOptions(_tolerance(spec), spec.option("exact"), spec.option("visible_distance"))
+    options = SceneOptions(spec_tolerance(spec), spec.option("exact"), spec.option("visible_distance"))
     result = query.match(trace, road_map, options)
     rows = [
         _window(trace, number, frame, frame, result.correspondence(frame))
@@ -206,7 +206,7 @@ def _scenario_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: Roa
 
         trace = label_trace(trace, road_map).trace
     find_all, explain = spec.option("all"), spec.option("explain")
-    options = ScenarioOptions(_tolerance(spec), spec.option("visible_distance"), find_all)
+    options = ScenarioOptions(spec_tolerance(spec), spec.option("visible_distance"), find_all)
     result = query.match(trace, spec.option("window"), road_map, options)
     rows = []
     for number, (match, first, last) in enumerate(result.windows()):

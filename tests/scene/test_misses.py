@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 import pytest
@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from scenegrep.cli.main import main
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
-from scenegrep.scene.misses import SLACK, MissLimits, NearestMisses, nearest_miss, rounded
+from scenegrep.scene.misses import CAPS, SCALES, SLACK, UNITS, MissLimits, NearestMisses, nearest_miss, rounded
 from tests.scene.frames import HEADER, MAP, ahead, right, trace_of
 
 AT = compile_scene(HEADER + "ego = new Car at (2, 30), facing 0.3, with regionContainedIn None\n")
@@ -74,6 +74,11 @@ def test_a_random_gap_is_searched_and_the_offsets_blamed():
     assert needed["position"].blame == ["c.x", "c.y"] and needed["heading"].blame == ["c.heading"]
     assert miss.correspondence == {"ego": "ego", "c": "c"}
     assert_smallest(AHEAD, frame, miss)
+
+
+def test_every_tolerance_is_searched():
+    """A tolerance added to Tolerance needs its scale, cap and unit here, or misses would skip it."""
+    assert {f.name for f in fields(Tolerance)} == set(SCALES) == set(CAPS) == set(UNITS)
 
 
 def test_a_frame_beyond_the_caps_is_no_miss():

@@ -364,13 +364,16 @@ class MapGeometry:
         return None
 
     @cached_property
-    def _intersection_areas(self) -> tuple[STRtree, list[np.ndarray]]:
-        """An R-tree of the intersection areas and, per area, its lanes' indices in the map's order."""
+    def _intersection_areas(self) -> tuple[STRtree, np.ndarray, np.ndarray]:
+        """An R-tree of the intersection areas, their lanes' indices (in the map's order) one area
+        after another, and where each area's lanes start in that array (one past the last at the end)."""
         road_map = self._require_map()
         index = road_map.lane_index
         areas = list(road_map.intersections)
-        lanes = [np.array([index[lane] for lane in a.lanes if lane in index], dtype=np.intp) for a in areas]
-        return STRtree(np.array([a.polygon for a in areas], dtype=object)), lanes
+        lanes = [[index[lane] for lane in a.lanes if lane in index] for a in areas]
+        starts = np.concatenate([[0], np.cumsum([len(group) for group in lanes])]).astype(np.intp)
+        flat = np.array([lane for group in lanes for lane in group], dtype=np.intp)
+        return STRtree(np.array([a.polygon for a in areas], dtype=object)), flat, starts
 
     def scenic_headings(self, field: Field, x: np.ndarray, y: np.ndarray, value: Values) -> np.ndarray:
         """The one heading Scenic itself computes for the field at each point (used to walk along it).
@@ -390,25 +393,31 @@ class MapGeometry:
         return chosen
 
     def _intersection_choice(self, x: np.ndarray, y: np.ndarray, chosen: np.ndarray) -> None:
+        """Points in an intersection area take the direction of the first of its lanes containing
+        them, else of the nearest (the first intersection area holding the point counts)."""
         road_map = self._require_map()
-        tree, area_lanes = self._intersection_areas
-        if not len(area_lanes):
+        tree, flat, starts = self._intersection_areas
+        if not len(flat):
             return
-        points, areas = tree.query(shapely.points(x, y), predicate="intersects")
-        for point in np.unique(points).tolist():
-            lanes = area_lanes[int(areas[points == point].min())]
-            if not len(lanes):
-                continue
-            here = shapely.Point(x[point], y[point])
-            inside = shapely.intersects(road_map.lane_polygons[lanes], here)
-            lane = (
-                lanes[np.argmax(inside)]
-                if inside.any()
-                else lanes[np.argmin(shapely.distance(road_map.lane_polygons[lanes], here))]
-            )
-            chosen[point] = road_map.centreline_polylines.direction_at(
-                np.array([lane]), x[point : point + 1], y[point : point + 1]
-            )[0]
+        points = shapely.points(x, y)
+        point, area = tree.query(points, predicate="intersects")
+        order = np.lexsort((area, point))
+        point, area = point[order], area[order]
+        first = np.ones(len(point), dtype=bool)
+        first[1:] = point[1:] != point[:-1]
+        point, area = point[first], area[first]
+        counts = starts[area + 1] - starts[area]
+        group = np.repeat(np.arange(len(point)), counts)
+        position = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+        lane = flat[starts[area][group] + position]
+        here = points[point[group]]
+        score = np.where(shapely.intersects(road_map.lane_polygons[lane], here), -1.0, 0.0)
+        outside = score == 0
+        score[outside] = shapely.distance(road_map.lane_polygons[lane[outside]], here[outside])
+        order = np.lexsort((position, score, group))
+        best = order[np.r_[True, group[order][1:] != group[order][:-1]]] if len(order) else order
+        rows = point[group[best]]
+        chosen[rows] = road_map.centreline_polylines.direction_at(lane[best], x[rows], y[rows])
 
     def field_headings_in_box(
         self, field: Field, x0: float, x1: float, y0: float, y1: float, value: Values

@@ -13,6 +13,9 @@
    interval branch-and-prune (:mod:`.branch_prune`), which also takes over when
    z3 times out.
 
+A row that follows ``roadDirection`` from a known start for a random distance skips these
+steps: :mod:`.walk` decides it exactly over the pieces of the walk, with a witness.
+
 The row is feasible when one piece is. Solver verdicts other than a proof of
 infeasibility keep the row (soundness first); ``delta-sat`` and ``undecided``
 verdicts are counted (in the evaluator's ``notes``) so the caller can report them.
@@ -33,6 +36,7 @@ from . import linear, smt
 from .branch_prune import BranchAndPrune, Outcome
 from .pointwise import satisfies
 from .problem import Bound, PointUnknown, Problem, build
+from .walk import find_walk, solve_walk
 
 
 def decide_rows(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
@@ -50,6 +54,9 @@ def solve(problem: Problem, geometry: MapGeometry, tolerance: Tolerance) -> Outc
     if not problem.unknowns:
         return Outcome("sat", {}, "direct") if satisfies(problem, geometry, {}) else Outcome("unsat", None, "direct")
     delta = max(tolerance.position, tolerance.heading)
+    walk = find_walk(problem)
+    if walk is not None:
+        return solve_walk(problem, geometry, walk, lambda piece, boxes: _solve_piece(piece, geometry, boxes, delta))
     search = BranchAndPrune(problem, geometry, delta)
     box = search.initial_box()
     box = None if box is None else search.contract(box)

@@ -1,0 +1,372 @@
+"""Every walk ``follow roadDirection from X for D`` can take, for a known start X and D in an interval.
+
+Scenic 3.1.1's ``VectorField.followFrom(X, D)`` (the ``follow`` operator and the ``following``
+specifier) takes ``n = max(4, ceil(D / 5))`` forward Euler steps of ``D / n`` metres; step k
+goes along the field's heading h_k at the point reached so far (heading 0 = +y, counter-clockwise,
+radians), so the end is ``X + D * a`` with ``a = (1/n) * sum_k (-sin h_k, cos h_k)``, and the
+object's heading is the field at the end. Headings are those of :mod:`.geometry`
+(:meth:`~.geometry.MapGeometry.scenic_headings` for the steps, every value of
+:meth:`~.geometry.MapGeometry.field_values` at the end).
+
+The field ``roadDirection`` is piecewise constant: a point takes the heading of one centreline
+segment of the lane (or intersection lane) holding it, or 0 off the lanes. The heading can only
+change where a point crosses the *linework*: a lane or intersection boundary, or, at each
+interior vertex of a centreline, its two segment normals and their bisector (where the nearest
+segment of a lane changes), each reaching across the lane. For a fixed step count and a fixed
+sequence of headings every point of the walk is affine in D, so the points of step k sweep a
+segment as D runs over an interval; cutting that segment where it crosses the linework gives
+sub-intervals of D on which h_k is constant (read at their midpoints). Doing this step by step
+partitions the D interval into *pieces* — D intervals with one heading sequence, hence one
+end ``X + D * a`` and one end heading — with at most one piece per crossing plus one per step
+count: the enumeration is exact and bounded, not a sample.
+
+Exact up to the boundaries between pieces (D values where a walk point lies on the linework,
+a finite set), with one assumption stated here: where a point lies in no lane but inside an
+intersection area, or (for the end heading) off every lane, the *nearest* lane's direction is
+read at the piece's midpoint, i.e. the nearest lane is assumed not to change inside a piece.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+
+from .follow import MIN_STEPS, STEP_M, steps_for
+from ..model.polylines import Polylines
+from .geometry import MapGeometry
+from .regions import Field
+
+MAX_STEPS = 400
+"""Largest step count enumerated (D up to 2 km); longer walks are left to the other solvers."""
+
+REACH_MARGIN_M = 1.0
+"""How far a vertex line reaches beyond the farthest point of its lane from the centreline."""
+
+DEGENERATE_M = 1e-12
+"""A swept segment shorter than this is a point: it crosses nothing."""
+
+TIE_M = 1e-7
+"""Two competing segments' equal distance counts as the nearest distance within this (metres)."""
+
+TURN_RAD = np.pi / 2
+"""Non-adjacent centreline segments compete for points of their lane only where the centreline
+turns by more than this between them (folds where pieces of a lane join, sharp bends); elsewhere
+the nearest segment changes at a vertex line."""
+
+SLACK = 1e-9
+"""Slack on a foot-of-perpendicular parameter when checking which distance piece holds."""
+
+
+@dataclass
+class Linework:
+    """Where ``roadDirection`` may change (see the module docstring): segments with an R-tree, and
+    pairs of non-adjacent centreline segments of one lane that may compete for a point, with an
+    R-tree of the boxes where they may (within the lane's reach of both)."""
+
+    start: np.ndarray
+    end: np.ndarray
+    tree: shapely.STRtree
+    pairs: np.ndarray
+    pair_lane: np.ndarray
+    pair_tree: shapely.STRtree
+    polylines: Polylines
+
+
+@dataclass
+class Pieces:
+    """D intervals with one heading sequence: for start ``row``, every D in [lo, hi] ends the walk
+    at ``start + D * (ax, ay)`` with the field taking ``heading`` there (a row per possible value)."""
+
+    row: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    ax: np.ndarray
+    ay: np.ndarray
+    heading: np.ndarray
+
+
+def linework(geometry: MapGeometry) -> Linework:
+    """The map's linework, built once per geometry."""
+    found = _LINEWORK.get(geometry)
+    if found is None:
+        found = _LINEWORK[geometry] = _build_linework(geometry)
+    return found
+
+
+def _build_linework(geometry: MapGeometry) -> Linework:
+    road_map = geometry._require_map()
+    areas = list(road_map.lane_polygons) + [a.polygon for a in road_map.intersections]
+    starts, ends = [], []
+    for ring in shapely.get_rings(np.array(areas, dtype=object)):
+        coords = shapely.get_coordinates(ring)
+        starts.append(coords[:-1])
+        ends.append(coords[1:])
+    polylines = road_map.centreline_polylines
+    reach = shapely.hausdorff_distance(shapely.boundary(road_map.lane_polygons), polylines.geometries)
+    for line, length in enumerate((reach + REACH_MARGIN_M).tolist()):
+        vertex_starts, vertex_ends = _vertex_lines(polylines.lines[line], length)
+        starts.append(vertex_starts)
+        ends.append(vertex_ends)
+    start, end = np.concatenate(starts), np.concatenate(ends)
+    keep = np.any(start != end, axis=1)
+    start, end = start[keep], end[keep]
+    tree = shapely.STRtree(shapely.linestrings(np.stack([start, end], axis=1)))
+    pairs, lanes, boxes = _competing_pairs(polylines, reach)
+    return Linework(start, end, tree, pairs, lanes, shapely.STRtree(boxes), polylines)
+
+
+def _competing_pairs(polylines: Polylines, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Non-adjacent segment pairs (i < j - 1, flat indices) of one centreline within twice the
+    lane's reach of each other, their lane, and the box of points within reach of both."""
+    segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
+    owner = np.repeat(np.arange(len(polylines)), polylines.count)
+    near = reach[owner] + REACH_MARGIN_M
+    i, j = shapely.STRtree(segments).query(segments, predicate="dwithin", distance=2 * near.max(initial=0.0))
+    turned = np.concatenate([[0.0], np.cumsum(np.abs(_wrap(np.diff(polylines.heading))))])
+    keep = (j > i + 1) & (owner[i] == owner[j])
+    i, j = i[keep], j[keep]
+    keep = turned[j] - turned[i] > TURN_RAD
+    i, j = i[keep], j[keep]
+    keep = shapely.distance(segments[i], segments[j]) <= 2 * near[i]
+    i, j = i[keep], j[keep]
+    lo = np.maximum(np.minimum(polylines.start[i], polylines.end[i]), np.minimum(polylines.start[j], polylines.end[j]))
+    hi = np.minimum(np.maximum(polylines.start[i], polylines.end[i]), np.maximum(polylines.start[j], polylines.end[j]))
+    r = near[i][:, None]
+    boxes = shapely.box(*(lo - r).T, *(hi + r).T)
+    return np.stack([i, j], axis=1), owner[i], boxes
+
+
+def _vertex_lines(vertices: np.ndarray, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """At each interior vertex of a polyline: the normals of its two segments and their bisector,
+    ``length`` each side."""
+    if len(vertices) < 3:
+        return np.zeros((0, 2)), np.zeros((0, 2))
+    direction = np.diff(vertices, axis=0)
+    direction /= np.hypot(direction[:, 0], direction[:, 1])[:, None]
+    normal = np.stack([-direction[:, 1], direction[:, 0]], axis=1)
+    before, after = normal[:-1], normal[1:]
+    bisector = before + after
+    size = np.hypot(bisector[:, 0], bisector[:, 1])[:, None]
+    bisector = np.where(size > 1e-9, bisector / np.maximum(size, 1e-300), direction[:-1])
+    vertex = vertices[1:-1]
+    lines = np.concatenate([before, after, bisector])
+    centre = np.concatenate([vertex, vertex, vertex])
+    return centre - length * lines, centre + length * lines
+
+
+def crossings(lw: Linework, px, py, qx, qy) -> tuple[np.ndarray, np.ndarray]:
+    """(segment index, parameter t in (0, 1)) where segment i from p_i to q_i crosses the linework
+    (for a stretch of linework along the segment, both ends of the overlap), or where two
+    competing centreline segments become equally near along it."""
+    moving = np.hypot(qx - px, qy - py) > DEGENERATE_M
+    index = np.flatnonzero(moving)
+    if not len(index):
+        return np.zeros(0, np.intp), np.zeros(0)
+    p = np.stack([px, py], 1)[index]
+    r = np.stack([qx, qy], 1)[index] - p
+    segments = shapely.linestrings(np.stack([p, p + r], axis=1))
+    walk, line = lw.tree.query(segments)
+    found_walk, found_t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
+    walk_pairs, pair = lw.pair_tree.query(segments)
+    tie_t, tie = _equal_distances(lw, p[walk_pairs], r[walk_pairs], pair)
+    found_walk = np.concatenate([walk[found_walk], walk_pairs[tie]])
+    found_t = np.concatenate([found_t, tie_t])
+    inside = (found_t > 0) & (found_t < 1)
+    return index[found_walk[inside]], found_t[inside]
+
+
+def _segment_crossings(p, r, a, s) -> tuple[np.ndarray, np.ndarray]:
+    """(hit index, t) where p + t r (t in [0, 1]) meets a + u s (u in [0, 1]); a collinear overlap
+    gives the parameters of both ends of the stretch."""
+    ap = a - p
+    denom = _cross(r, s)
+    safe = np.where(denom == 0, 1.0, denom)
+    t, u = _cross(ap, s) / safe, _cross(ap, r) / safe
+    hit = np.flatnonzero((denom != 0) & (u >= 0) & (u <= 1))
+    collinear = np.flatnonzero((denom == 0) & (_cross(ap, r) == 0))
+    rr = np.einsum("ij,ij->i", r, r)
+    ends = [np.einsum("ij,ij->i", ap[collinear] + k * s[collinear], r[collinear]) / rr[collinear] for k in (0, 1)]
+    return np.concatenate([hit, collinear, collinear]), np.concatenate([t[hit], *ends])
+
+
+def _distance_pieces(polylines: Polylines, segment: np.ndarray, p, r) -> tuple[np.ndarray, np.ndarray]:
+    """Squared distance from p + t r to each segment, as three quadratics in t (coefficients
+    [piece, (t², t, 1)]: nearest to the start vertex, to the interior, to the end vertex), and
+    the segment parameter of the foot of the perpendicular, (s0, s1) with s = s0 + s1 t."""
+    a = polylines.start[segment]
+    w = polylines.end[segment] - a
+    ll = np.einsum("ij,ij->i", w, w)
+    rr = np.einsum("ij,ij->i", r, r)
+    pa, pb = p - a, p - a - w
+    cw, cr = _cross(pa, w), _cross(r, w)
+    quads = np.stack(
+        [
+            np.stack([rr, 2 * np.einsum("ij,ij->i", pa, r), np.einsum("ij,ij->i", pa, pa)], 1),
+            np.stack([cr * cr / ll, 2 * cw * cr / ll, cw * cw / ll], 1),
+            np.stack([rr, 2 * np.einsum("ij,ij->i", pb, r), np.einsum("ij,ij->i", pb, pb)], 1),
+        ],
+        1,
+    )
+    return quads, np.stack([np.einsum("ij,ij->i", pa, w) / ll, np.einsum("ij,ij->i", r, w) / ll], 1)
+
+
+def _equal_distances(lw: Linework, p, r, pair) -> tuple[np.ndarray, np.ndarray]:
+    """(t, hit index) where the two segments of ``pair[h]`` are equally near p + t r and no
+    segment of their centreline is nearer (where the nearest segment may jump between them)."""
+    i, j = lw.pairs[pair, 0], lw.pairs[pair, 1]
+    qi, si = _distance_pieces(lw.polylines, i, p, r)
+    qj, sj = _distance_pieces(lw.polylines, j, p, r)
+    diff = qi[:, :, None, :] - qj[:, None, :, :]
+    roots = _quadratic_roots(diff[..., 0], diff[..., 1], diff[..., 2])
+    hit, piece_i, piece_j, _ = np.nonzero((roots > 0) & (roots < 1))
+    t = roots[hit, piece_i, piece_j, _]
+    valid = _in_piece(si[hit], piece_i, t) & _in_piece(sj[hit], piece_j, t)
+    hit, piece_i, t = hit[valid], piece_i[valid], t[valid]
+    quad = qi[hit, piece_i]
+    own = np.sqrt(np.maximum(quad[:, 0] * t * t + quad[:, 1] * t + quad[:, 2], 0.0))
+    points = shapely.points(p[hit] + t[:, None] * r[hit])
+    nearest = shapely.distance(points, lw.polylines.geometries[lw.pair_lane[pair[hit]]])
+    keep = own <= nearest + TIE_M
+    return t[keep], hit[keep]
+
+
+def _wrap(angle: np.ndarray) -> np.ndarray:
+    return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+def _in_piece(s: np.ndarray, piece: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Whether the foot parameter s0 + s1 t lies in the range of the distance piece (with slack)."""
+    foot = s[:, 0] + s[:, 1] * t
+    return np.where(
+        piece == 0, foot <= SLACK, np.where(piece == 1, (foot >= -SLACK) & (foot <= 1 + SLACK), foot >= 1 - SLACK)
+    )
+
+
+def _quadratic_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """The real roots of a t² + b t + c (shape (..., 2); NaN where absent)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        scale = np.abs(a) + np.abs(b) + np.abs(c)
+        linear = np.abs(a) <= 1e-12 * scale
+        disc = b * b - 4 * a * c
+        q = -(b + np.copysign(np.sqrt(np.where(disc >= 0, disc, np.nan)), b)) / 2
+        first = np.where(linear, -c / b, q / a)
+        second = np.where(linear, np.nan, c / q)
+    return np.stack([first, second], -1)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+
+
+@dataclass
+class _Branches:
+    """Walks under enumeration: start row, D interval, step count, and the end so far (X + D a)."""
+
+    row: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    steps: np.ndarray
+    ax: np.ndarray
+    ay: np.ndarray
+
+    def take(self, index: np.ndarray) -> _Branches:
+        return _Branches(*(getattr(self, k)[index] for k in ("row", "lo", "hi", "steps", "ax", "ay")))
+
+
+def follow_pieces(
+    geometry: MapGeometry, field: Field, x: np.ndarray, y: np.ndarray, lo: np.ndarray, hi: np.ndarray
+) -> Pieces:
+    """The pieces of the walks from (x[i], y[i]) for every D in [lo[i], hi[i]] (metres, finite,
+    lo <= hi, hi <= STEP_M * MAX_STEPS); see the module docstring."""
+    lw = linework(geometry)
+    b = _by_step_count(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    for k in range(int(b.steps.max(initial=0))):
+        walking = k < b.steps
+        moved = _step(geometry, field, lw, x, y, b.take(np.flatnonzero(walking)))
+        b = _concat(b.take(np.flatnonzero(~walking)), moved)
+    return _ends(geometry, field, lw, x, y, b)
+
+
+def _by_step_count(lo: np.ndarray, hi: np.ndarray) -> _Branches:
+    """One branch per start and step count its D interval allows (n = 4 up to 20 m, then
+    (5 (n - 1), 5 n] for n)."""
+    first, last = steps_for(lo), steps_for(hi)
+    counts = last - first + 1
+    row = np.repeat(np.arange(len(lo)), counts)
+    steps = np.repeat(first, counts) + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
+    low = np.maximum(lo[row], np.where(steps > MIN_STEPS, STEP_M * (steps - 1), -np.inf))
+    high = np.minimum(hi[row], STEP_M * steps.astype(float))
+    zeros = np.zeros(len(row))
+    return _Branches(row, low, high, steps, zeros, zeros.copy())
+
+
+def _split(lw: Linework, x, y, b: _Branches) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cut each branch's D interval where its current point crosses the linework:
+    (branch index, lo, hi) of the sub-intervals, in branch then D order."""
+    px, py = x[b.row] + b.lo * b.ax, y[b.row] + b.lo * b.ay
+    qx, qy = x[b.row] + b.hi * b.ax, y[b.row] + b.hi * b.ay
+    walk, t = crossings(lw, px, py, qx, qy)
+    n = len(b.row)
+    owner = np.concatenate([np.arange(n), np.arange(n), walk])
+    cut = np.concatenate([np.zeros(n), np.ones(n), t])
+    order = np.lexsort((cut, owner))
+    owner, cut = owner[order], cut[order]
+    pair = (owner[:-1] == owner[1:]) & (cut[1:] > cut[:-1])
+    branch = owner[:-1][pair]
+    width = b.hi[branch] - b.lo[branch]
+    low = b.lo[branch] + cut[:-1][pair] * width
+    high = np.where(cut[1:][pair] == 1, b.hi[branch], b.lo[branch] + cut[1:][pair] * width)
+    return branch, low, high
+
+
+def _step(geometry: MapGeometry, field: Field, lw: Linework, x, y, b: _Branches) -> _Branches:
+    """Every branch takes its next step: split where the heading may change, then move."""
+    branch, low, high = _split(lw, x, y, b)
+    mid = (low + high) / 2
+    heading = geometry.scenic_headings(
+        field, x[b.row[branch]] + mid * b.ax[branch], y[b.row[branch]] + mid * b.ay[branch], _no_terms
+    )
+    branch, low, high, heading = _merge(branch, low, high, heading)
+    moved = b.take(branch)
+    moved.lo, moved.hi = low, high
+    moved.ax = moved.ax - np.sin(heading) / moved.steps
+    moved.ay = moved.ay + np.cos(heading) / moved.steps
+    return moved
+
+
+def _merge(branch, low, high, heading):
+    """Join neighbouring sub-intervals of one branch that take the same heading."""
+    order = np.lexsort((low, branch))
+    branch, low, high, heading = branch[order], low[order], high[order], heading[order]
+    new = np.ones(len(branch), dtype=bool)
+    new[1:] = (branch[1:] != branch[:-1]) | (heading[1:] != heading[:-1])
+    starts = np.flatnonzero(new)
+    ends = np.append(starts[1:], len(branch)) - 1
+    return branch[starts], low[starts], high[ends], heading[starts]
+
+
+def _ends(geometry: MapGeometry, field: Field, lw: Linework, x, y, b: _Branches) -> Pieces:
+    """The pieces: each branch cut where the end's field values may change, one per value."""
+    branch, low, high = _split(lw, x, y, b)
+    mid = (low + high) / 2
+    ex, ey = x[b.row[branch]] + mid * b.ax[branch], y[b.row[branch]] + mid * b.ay[branch]
+    rows, headings = geometry.field_values(field, ex, ey, _no_terms)
+    piece = branch[rows]
+    return Pieces(b.row[piece], low[rows], high[rows], b.ax[piece], b.ay[piece], headings)
+
+
+def _concat(a: _Branches, b: _Branches) -> _Branches:
+    return _Branches(
+        *(np.concatenate([getattr(a, k), getattr(b, k)]) for k in ("row", "lo", "hi", "steps", "ax", "ay"))
+    )
+
+
+def _no_terms(term):
+    raise ValueError(f"roadDirection has no parameters, got {term!r}")
+
+
+_LINEWORK: weakref.WeakKeyDictionary[MapGeometry, Linework] = weakref.WeakKeyDictionary()

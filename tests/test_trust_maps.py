@@ -192,3 +192,21 @@ def test_a_snet_named_as_any_map_or_file_of_a_wrong_kind_is_one_line(planted, ca
         code, err = run(folder, capsys, *args)
         assert code == 2 and len(err) == 1 and message in err[0], err
     assert not marker.exists()
+
+
+def test_a_parquet_traces_map_path_is_relative_to_the_trace_never_the_working_directory(planted, capsys):
+    """``label`` stores the map relative to its output; a map named only in the working
+    directory is not picked up from there."""
+    from scenegrep.readers import read_trace
+
+    folder, marker = planted
+    assert run(folder, capsys, "label", "town.json", "-o", "out/labelled")[0] == 0
+    written = folder / "out" / "labelled" / "hostile.parquet"
+    assert read_trace(written).map_source.path == str(folder / "Town01.xodr")
+    moved = folder / "elsewhere"
+    moved.mkdir()
+    shutil.move(written, moved / "hostile.parquet")
+    code, err = run(folder, capsys, "info", "elsewhere/hostile.parquet")
+    missing = "../Town01.xodr: no such file (expected a road map (opendrive))"  # not ./Town01.xodr
+    assert code == 2 and err == [f"scenegrep: error: {missing}"]
+    assert not marker.exists()

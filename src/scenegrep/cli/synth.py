@@ -1,7 +1,8 @@
 """``scenegrep synth PROGRAM.scenic --map MAP --runs N --steps T -o DIR``: simulated label traces.
 
 Runs a Scenic program N times in Scenic's Newtonian driving simulator (see
-:mod:`scenegrep.synth.simulate`), optionally adds perception-like noise
+:mod:`scenegrep.synth.simulate`; Scenic executes the program's Python code, so this is for
+programs the user trusts), optionally adds perception-like noise
 (:mod:`scenegrep.synth.noise`), and writes ``DIR/<program stem>-<run:03d>.parquet`` (scenegrep
 Parquet traces, each written atomically, replacing a file of the same name) and
 ``DIR/manifest.json``. Each trace's map path is stored relative to DIR, so the directory and
@@ -31,7 +32,10 @@ def add_parser(subparsers: Any) -> None:
         help="simulate a Scenic program into labeled traces",
         description="Run a Scenic program (model scenic.simulators.newtonian.driving_model) N times in Scenic's "
         "Newtonian driving simulator and write one scenegrep Parquet trace per run, with positions, headings, "
-        "velocities, lanes and the primitive behaviour running at each 0.1 s step, plus DIR/manifest.json.",
+        "velocities, lanes and the primitive behaviour running at each 0.1 s step, plus DIR/manifest.json. "
+        "Warning: Scenic runs the program's Python code with your rights (that is Scenic's nature); synth only "
+        "programs you trust. The map must be an OpenDRIVE .xodr file; Scenic reads a copy of it in scenegrep's "
+        "cache and never a .snet file beside it.",
     )
     parser.add_argument("program", metavar="PROGRAM", help="a .scenic file using the Newtonian driving model")
     parser.add_argument("--map", required=True, metavar="MAP", help="OpenDRIVE road map (.xodr)")
@@ -98,13 +102,13 @@ def run(args: argparse.Namespace) -> int:
         max_iterations=args.max_iterations,
         noise=noise,
     )
-    stored_map = MapSource(_relative(args.map, out), "opendrive")
+    stored_map = MapSource(os.path.relpath(args.map), "opendrive")
     stored_program = _relative(args.program, out)
     entries: list[dict[str, Any]] = []
     try:
         for trace in tqdm(traces, total=args.runs, desc=Path(args.program).name, unit="run", disable=args.quiet):
             path = write_trace_parquet(replace(trace, map_source=stored_map), out / f"{trace.name}.parquet")
-            entries.append(_entry(path.name, trace, stored_program, stored_map.path))
+            entries.append(_entry(path.name, trace, stored_program, _relative(args.map, out)))
     finally:  # the manifest lists what was written, even when a later run fails
         if entries:
             _write_manifest(out / MANIFEST, previous, entries)

@@ -42,14 +42,13 @@ def _read(path: str | Path, what: str, is_kind: Callable[[pa.Schema], bool], con
 
 
 def read_trace(path: str | Path) -> LabelTrace:
-    """Read a scenegrep Parquet trace. A relative map path names a file beside the trace when
-    one is there (as ``scenegrep synth`` writes it), else it stays relative to the working directory."""
+    """Read a scenegrep Parquet trace. A relative map path is relative to the trace's folder
+    (as :func:`~scenegrep.writers.write_trace_parquet` stores it), never to the working directory."""
     trace = _read(path, "trace", is_trace_table, trace_from_table)
     source = trace.map_source
     if source is None or Path(source.path).is_absolute():
         return trace
-    beside = os.path.normpath(Path(path).parent / source.path)
-    return replace(trace, map_source=replace(source, path=beside)) if os.path.exists(beside) else trace
+    return replace(trace, map_source=replace(source, path=os.path.normpath(Path(path).parent / source.path)))
 
 
 def read_map(path: str | Path) -> RoadMap:

@@ -14,7 +14,9 @@ over the vehicles (cars, trucks, buses, trailers, motorcycles) and the ego:
   the larger coordinate of |p(t) - (p(t-1) + p(t+1)) / 2| (deviation from a smooth track: a
   constant-velocity track gives 0, and braking at 3 m/s² at 10 Hz only 0.015 m);
 * ``heading_jitter`` (rad): the same for the heading of moving vehicles (circular midpoint);
-* ``size_deviation`` (m): the larger of |length - the track's median| and |width - its median|.
+* ``size_deviation`` (m): the larger of |length - the track's median| and |width - its median|;
+* ``velocity_vs_track`` (m/s): where the data labels velocities, the largest of |vx - vx'|,
+  |vy - vy'| and |speed - speed'| against the track's own finite differences (the primed values).
 
 It prints the median and the 90th, 95th and 99th percentiles of each per dataset, and the
 profile they give (:data:`scenegrep.scene.profiles.PROFILES` holds these values, documented in
@@ -62,6 +64,7 @@ MEASURES = (
     "position_jitter",
     "heading_jitter",
     "size_deviation",
+    "velocity_vs_track",
 )
 
 
@@ -126,6 +129,17 @@ def axis_offsets(frame: np.ndarray, lane: np.ndarray, x: np.ndarray, y: np.ndarr
     return np.abs(across[ahead])
 
 
+def velocity_measures(trace: LabelTrace) -> dict[str, np.ndarray]:
+    """``velocity_vs_track`` of the vehicles whose velocity the data labels."""
+    states = trace.states
+    vx, vy = finite_difference_velocity(states, trace.frame_time)
+    difference = np.fmax(
+        np.maximum(np.abs(states.vx - vx), np.abs(states.vy - vy)),
+        np.abs(states.speed() - np.hypot(vx, vy)),
+    )
+    return {"velocity_vs_track": difference[vehicles(trace) & np.isfinite(difference)]}
+
+
 def pairs_within_groups(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Every ordered pair (i, j) of positions of a sorted ``key`` array with equal keys."""
     starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
@@ -184,7 +198,9 @@ def measure(paths: list[Path]) -> dict[str, np.ndarray]:
     for path in paths:
         for trace in readers.read_traces(path):
             road_map = readers.read_map(trace.map_source) if trace.map_source is not None else None
-            for name, values in (lane_measures(trace, road_map) | track_measures(trace)).items():
+            for name, values in (
+                lane_measures(trace, road_map) | track_measures(trace) | velocity_measures(trace)
+            ).items():
                 samples[name].append(values[np.isfinite(values)])
     return {name: np.concatenate(parts) if parts else np.zeros(0) for name, parts in samples.items()}
 

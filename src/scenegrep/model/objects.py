@@ -22,8 +22,9 @@ class ObjectTable(RowTable):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if len(set(self.id.tolist())) != len(self.id):
-            raise ValueError("object ids must be unique")
+        unique, counts = np.unique(self.id.astype(str), return_counts=True)
+        if len(unique) != len(self.id):
+            raise ValueError(f"object ids must be unique: {str(unique[np.argmax(counts > 1)])!r} is given twice")
 
     @classmethod
     def build(cls, ids, categories, attributes: list[dict[str, Any]] | None = None) -> ObjectTable:

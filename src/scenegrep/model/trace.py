@@ -23,6 +23,18 @@ from .objects import ObjectTable
 from .states import StateTable
 
 
+MAX_FRAMES = 10_000_000
+"""The most frames a trace may have (about 11.5 days at 10 Hz): a frame count or range a file
+states is checked against it before any array is sized by it."""
+
+
+def checked_frame_count(n: int) -> int:
+    """``n`` when it is a frame count a trace may have (0..:data:`MAX_FRAMES`); ValueError otherwise."""
+    if not 0 <= n <= MAX_FRAMES:
+        raise ValueError(f"{n} frames: a trace has 0 to {MAX_FRAMES} frames")
+    return n
+
+
 @dataclass(frozen=True)
 class MapSource:
     """Where a trace's road map can be read: a file or directory path, its format name, and
@@ -120,8 +132,39 @@ class LabelTrace:
             raise ValueError("behaviour labels must align with state rows")
         if self.ego is not None and self.ego not in self.objects.row_of():
             raise ValueError(f"ego {self.ego!r} is not an object of the trace")
+        self._validate_values()
         if self.images is not None:
             self._validate_images(self.images)
+
+    def _validate_values(self) -> None:
+        """Raise ValueError naming the first bad value: known frame times (NaN: unknown) must be
+        finite and strictly increasing; positions and headings
+        finite; no column infinite; sizes not negative (NaN: unknown)."""
+        times = self.frame_time
+        known = ~np.isnan(times)
+        if np.isinf(times).any():
+            raise ValueError(f"frame {self._frame_name(int(np.argmax(np.isinf(times))))}: time is infinite")
+        steps = np.diff(times[known])
+        if (steps <= 0).any():
+            position = int(np.argmax(steps <= 0)) + 1
+            raise ValueError(f"frame {self._frame_name(position)}: time does not increase (frame times must increase)")
+        s = self.states
+        for name in ("x", "y", "heading", "z", "length", "width", "height", "vx", "vy"):
+            values = getattr(s, name)
+            required = name in ("x", "y", "heading")
+            bad = ~np.isfinite(values) if required else np.isinf(values)
+            if name in ("length", "width", "height"):
+                bad |= values < 0
+            if bad.any():
+                row = int(np.argmax(bad))
+                raise ValueError(f"{self._state_name(row)}: {name} is {float(values[row])!r} (must be {_RULES[name]})")
+
+    def _frame_name(self, position: int) -> str:
+        return f"{position} (index {self.frame_index[position]})"
+
+    def _state_name(self, row: int) -> str:
+        s = self.states
+        return f"frame {self._frame_name(int(s.frame[row]))}, object {self.objects.id[s.object[row]]!r}"
 
     def _validate_images(self, images: ImageLayer) -> None:
         samples, boxes = images.samples, images.boxes
@@ -236,6 +279,20 @@ class LabelTrace:
         if not (self.objects.equals(other.objects) and self.states.equals(other.states)):
             return False
         return _optional_equal(self.behaviours, other.behaviours) and _optional_equal(self.images, other.images)
+
+
+_RULES = {
+    "x": "finite",
+    "y": "finite",
+    "heading": "finite",
+    "z": "finite or unknown",
+    "vx": "finite or unknown",
+    "vy": "finite or unknown",
+    "length": "finite, not negative, or unknown",
+    "width": "finite, not negative, or unknown",
+    "height": "finite, not negative, or unknown",
+}
+"""What each state column may hold (NaN means unknown), for :meth:`LabelTrace.validate`'s messages."""
 
 
 def _optional_equal(a: Any, b: Any) -> bool:

@@ -26,7 +26,7 @@ from .behaviours import BehaviourLabels
 from .images import BoxTable, ImageLayer, SampleTable
 from .objects import ObjectTable
 from .states import FLOAT_COLUMNS, StateTable
-from .trace import LabelTrace, MapSource, TraceSource
+from .trace import LabelTrace, MapSource, TraceSource, checked_frame_count
 
 METADATA_KEY = b"scenegrep"
 LAYOUT_VERSION = 1
@@ -265,7 +265,7 @@ def trace_from_table(table: pa.Table) -> LabelTrace:
         raise ValueError(f"unsupported trace layout {meta.get('layout')!r} (this scenegrep reads {LAYOUT_VERSION})")
     kind = _codes(table.column("kind"), list(KINDS))
     position = _numpy(table, "position", np.int64)
-    n_frames = int(position.max()) + 1 if len(position) else 0
+    n_frames = checked_frame_count(int(position.max()) + 1 if len(position) else 0)
     frame_index = np.zeros(n_frames, dtype=np.int64)
     frame_time = np.zeros(n_frames)
     frame_index[position] = _numpy(table, "frame", np.int64)

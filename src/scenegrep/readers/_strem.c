@@ -887,7 +887,14 @@ static PyObject *parse(PyObject *self, PyObject *args, PyObject *kwargs) {
         result = result_dict(&p);
     } else if (p.error && !PyErr_Occurred()) {
         PyObject *where = where_text(&p);
-        if (where) PyErr_SetObject(PyExc_ValueError, Py_BuildValue("(snN)", p.error, (Py_ssize_t)p.error_pos, where));
+        /* a message may quote input bytes that are not UTF-8: shown as \xNN escapes */
+        PyObject *message = PyUnicode_DecodeUTF8(p.error, (Py_ssize_t)strlen(p.error), "backslashreplace");
+        if (where && message)
+            PyErr_SetObject(PyExc_ValueError, Py_BuildValue("(NnN)", message, (Py_ssize_t)p.error_pos, where));
+        else {
+            Py_XDECREF(where);
+            Py_XDECREF(message);
+        }
     }
     parser_free(&p);
     PyBuffer_Release(&view);

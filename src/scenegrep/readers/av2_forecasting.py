@@ -18,6 +18,7 @@ import pyarrow.parquet as pq
 from ..errors import UserError, at
 from ..model import LabelTrace, MapSource, ObjectTable, StateTable, TraceSource
 from ..model.geometry import heading_from_yaw
+from ..model.trace import checked_frame_count
 from .av2_map import FORMAT as MAP_FORMAT
 from .av2_map import find_map
 from .common import reading
@@ -60,7 +61,9 @@ def read_trace(path: str | Path) -> LabelTrace:
         raise UserError(f"missing column(s) {', '.join(missing)}", at(file))
     col = {c: table.column(c).to_numpy(zero_copy_only=False) for c in table.column_names}
     tracks, track_row = np.unique(col["track_id"].astype(str), return_inverse=True)
-    n_steps = int(col["num_timestamps"][0])
+    if table.num_rows == 0:
+        raise UserError("holds no rows", at(file))
+    n_steps = checked_frame_count(int(col["num_timestamps"][0]))
     interval = (float(col["end_timestamp"][0]) - float(col["start_timestamp"][0])) / 1e9 / max(n_steps - 1, 1)
     first = np.unique(track_row, return_index=True)[1]
     objects = ObjectTable.build(tracks.tolist(), col["object_type"][first].astype(str).tolist())

@@ -63,6 +63,8 @@ def _columns(path: Path, names: tuple[str, ...]) -> dict[str, np.ndarray]:
     missing = [n for n in names if n not in table.column_names]
     if missing:
         raise UserError(f"missing column(s) {', '.join(missing)}", at(path))
+    if table.num_rows == 0:
+        raise UserError("holds no rows", at(path))
     return {n: table.column(n).to_numpy(zero_copy_only=False) for n in names}
 
 

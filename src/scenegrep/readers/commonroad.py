@@ -49,6 +49,7 @@ import shapely
 from ..errors import UserError, at
 from ..model import Lane, LaneNeighbour, LabelTrace, MapSource, ObjectTable, RoadMap, StateTable, TraceSource
 from ..model.geometry import heading_from_yaw
+from ..model.trace import checked_frame_count
 from ..model.lane_shapes import resample_polyline
 from ..model.lane_topology import derive_intersections, derive_roads
 from .common import read_bytes
@@ -352,7 +353,8 @@ def read_trace(path: str | Path) -> LabelTrace:
     name = _name(doc)
     obstacles = [_obstacle(doc, e) for e in _unique_ids(doc, _obstacle_elements(doc.root), "obstacle")]
     steps = np.concatenate([o.rows[:, 0] for o in obstacles]).astype(np.int64) if obstacles else np.zeros(0, np.int64)
-    frame_index = np.arange(steps.min(), steps.max() + 1) if len(steps) else steps
+    span = checked_frame_count(int(steps.max() - steps.min()) + 1 if len(steps) else 0)
+    frame_index = steps.min() + np.arange(span) if len(steps) else steps
     states = _states(obstacles, frame_index)
     objects = ObjectTable.build(
         [o.id for o in obstacles],

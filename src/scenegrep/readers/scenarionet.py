@@ -41,6 +41,7 @@ import shapely
 from ..errors import UserError, at
 from ..model import Area, Lane, LaneNeighbour, LabelTrace, MapSource, ObjectTable, RoadMap, StateTable, TraceSource
 from ..model.geometry import heading_from_yaw
+from ..model.trace import checked_frame_count
 from ..model.lane_shapes import lane_polygon
 from ..model.lane_topology import (
     crossing_lanes,
@@ -156,7 +157,7 @@ def read_trace(path: str | Path) -> LabelTrace:
     path = Path(path)
     scenario = load_scenario(path)
     meta = scenario["metadata"]
-    n = int(scenario.get("length") or len(meta.get("ts", ())))
+    n = checked_frame_count(int(scenario.get("length") or len(meta.get("ts", ()))))
     times = np.asarray(meta.get("ts", np.arange(n) * float(meta.get("sample_rate", 0.1))), dtype=np.float64)[:n]
     ids, categories, columns = _states(scenario, n, path)
     ego = str(meta["sdc_id"]) if meta.get("sdc_id") is not None and str(meta["sdc_id"]) in ids else None

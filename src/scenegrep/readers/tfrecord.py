@@ -16,6 +16,7 @@ count from the start of the file.
 
 from __future__ import annotations
 
+import os
 import struct
 from pathlib import Path
 from typing import BinaryIO
@@ -70,6 +71,9 @@ def _records(handle: BinaryIO, path: str | Path) -> Iterator[bytes]:
         length, length_crc = _HEADER.unpack(head)
         _check_crc(head[:8], length_crc, path, number, offset, "record length")
         data_offset = offset + _HEADER.size
+        available = os.fstat(handle.fileno()).st_size - data_offset
+        if length + _FOOTER.size > available:
+            raise _truncated(path, number, data_offset, "record data", length + _FOOTER.size, available)
         body = handle.read(length + _FOOTER.size)
         if len(body) != length + _FOOTER.size:
             raise _truncated(path, number, data_offset, "record data", length + _FOOTER.size, len(body))

@@ -3,7 +3,7 @@
 ::
 
     {"scenegrep": "trace", "version": 1, "name": "lane change", "ego": "car2",
-     "frame_interval": 0.1,                      # optional: time of frame k = k * interval (s)
+     "frame_interval": 0.1,                      # optional, > 0: time of frame k = k * interval (s)
      "map": {"path": "Town06.xodr", "format": "opendrive"},   # optional; relative to this file;
                                                  # "key" names one map of a file holding several
      "attributes": {"weather": "clear"},         # optional free attributes
@@ -95,7 +95,7 @@ class _Trace(Struct, forbid_unknown_fields=True):
     frames: list[_Frame]
     name: str | None = None
     ego: str | None = None
-    frame_interval: float | None = None
+    frame_interval: Annotated[float, Meta(gt=0)] | None = None
     map: _MapRef | None = None
     attributes: dict[str, Any] = {}
 

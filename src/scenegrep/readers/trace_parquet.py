@@ -34,7 +34,7 @@ def kind(path: str | Path) -> str | None:
 
 def _read(path: str | Path, what: str, is_kind: Callable[[pa.Schema], bool], convert: Callable[[pa.Table], T]) -> T:
     """A scenegrep Parquet file of one kind (``what``: trace or map) converted from its table."""
-    with reading(path, f"scenegrep Parquet {what}", pa.ArrowException, ValueError):
+    with reading(path, f"scenegrep Parquet {what}", pa.ArrowException):
         table = pq.read_table(path)
         if not is_kind(table.schema):
             raise UserError(f"a Parquet file without scenegrep {what} metadata", at(path))

@@ -1,0 +1,138 @@
+"""Malformed and hostile inputs, one per class the fuzz suite found: each is a one-line
+:class:`UserError` naming the file (and the place where known), decided before memory or time
+is spent on what the file claims."""
+
+from __future__ import annotations
+
+import io
+import json
+import pickle
+import shutil
+import struct
+import time
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.feather as feather
+import pyarrow.parquet as pq
+import pytest
+
+from scenegrep import readers
+from scenegrep.errors import UserError
+from scenegrep.readers.scenarionet import RestrictedUnpickler
+from scenegrep.readers.tfrecord import masked_crc32c
+from tests.conftest import REPO
+
+SAMPLE = REPO / "examples/sample/s3_pass_pedestrian-000.parquet"
+
+
+def _error(path) -> str:
+    """The one line of the user error reading ``path`` gives (fails if it reads)."""
+    with pytest.raises(UserError) as caught:
+        list(readers.read_traces(path))
+    line = caught.value.one_line()
+    assert str(path) in line and "\n" not in line
+    return line
+
+
+def _json_trace(tmp_path, frames, **top) -> str:
+    document = {"scenegrep": "trace", "version": 1, "objects": {"a": {"class": "Car"}}, "frames": frames, **top}
+    path = tmp_path / "t.json"
+    path.write_text(json.dumps(document).replace("Infinity", "1e999"))
+    return _error(path)
+
+
+def _at(x, time=None):
+    frame = {"objects": {"a": {"position": [x, 0], "heading": 0.0}}}
+    return frame if time is None else {**frame, "time": time}
+
+
+def test_a_parquet_frame_position_of_2_31_is_refused_before_sizing_arrays(tmp_path):
+    """The 20 KB file that asked for 32 GB: a frame position sized the frame arrays."""
+    table = pq.read_table(SAMPLE)
+    position = table.column("position").to_numpy().astype(np.int64)
+    position[0] = 2**31
+    table = table.set_column(table.column_names.index("position"), "position", pa.array(position))
+    path = tmp_path / "huge.parquet"
+    pq.write_table(table, path)
+    start = time.monotonic()
+    assert "2147483649 frames: a trace has 0 to 10000000 frames" in _error(path)
+    assert time.monotonic() - start < 5
+
+
+@pytest.mark.parametrize("interval", [0, -0.1])
+def test_a_non_positive_frame_interval_is_refused(tmp_path, interval):
+    assert "frame_interval" in _json_trace(tmp_path, [_at(0), _at(1)], frame_interval=interval)
+
+
+def test_times_must_increase(tmp_path):
+    line = _json_trace(tmp_path, [_at(0, 0.0), _at(1, 0.2), _at(2, 0.1)])
+    assert "frame 2 (index 2): time does not increase" in line
+
+
+@pytest.mark.parametrize("value, shown", [(np.inf, "inf"), (-np.inf, "-inf"), (np.nan, "nan")])
+def test_non_finite_positions_are_refused(tmp_path, value, shown):
+    table = pq.read_table(SAMPLE)
+    x = table.column("x").to_numpy().copy()
+    x[5] = value
+    path = tmp_path / "x.parquet"
+    pq.write_table(table.set_column(table.column_names.index("x"), "x", pa.array(x)), path)
+    assert f"x is {shown} (must be finite)" in _error(path)
+
+
+def test_a_tfrecord_length_beyond_the_file_is_refused_before_reading(tmp_path):
+    header = struct.pack("<Q", 2**40)
+    path = tmp_path / "huge.tfrecord"
+    path.write_bytes(header + struct.pack("<I", masked_crc32c(header)) + b"x" * 100)
+    assert "truncated record data at byte 12: expected 1099511627780 bytes, the file ends after 100" in _error(path)
+
+
+def test_an_empty_av2_annotation_table_is_refused(real_data, tmp_path):
+    log = tmp_path / "log"
+    shutil.copytree(real_data / "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede", log)
+    annotations = log / "annotations.feather"
+    annotations.chmod(0o644)
+    feather.write_feather(feather.read_table(annotations).slice(0, 0), annotations)
+    assert _error(log) == f"{annotations}: holds no rows"
+
+
+def test_duplicate_track_ids_of_different_types_are_refused(real_data, tmp_path):
+    source = real_data / "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0757.pkl"
+    scenario = RestrictedUnpickler(io.BytesIO(source.read_bytes())).load()
+    track = next(iter(scenario["tracks"].values()))
+    scenario["tracks"]["7"] = track
+    scenario["tracks"][7] = track
+    path = tmp_path / "dup.pkl"
+    path.write_bytes(pickle.dumps(scenario))
+    assert "object ids must be unique: '7' is given twice" in _error(path)
+
+
+def test_a_huge_commonroad_time_step_is_refused(real_data, tmp_path):
+    path = tmp_path / "far.xml"
+    text = (real_data / "commonroad_ngsim/USA_US101-3_3_T-1.xml").read_text()
+    path.write_text(text.replace("<time>\n        <exact>0</exact>", "<time>\n        <exact>99999999999</exact>", 1))
+    assert "frames: a trace has 0 to 10000000 frames" in _error(path)
+
+
+def test_invalid_utf8_in_a_strem_file_is_shown_escaped(tmp_path):
+    path = tmp_path / "s.json"
+    path.write_bytes(b'{"version": "0.2.0", "frames": [\xff]}')
+    assert _error(path) == f"{path}:1:33: frames[0]: expected '{{' but found '\\xff'"
+
+
+@pytest.mark.parametrize("value", [[{"x": 1.0, "y": 2.0}, [1, 2, 3]], "x", None, {"x": []}])
+def test_a_map_value_of_a_wrong_type_is_one_line(real_data, tmp_path, value):
+    source = real_data / "av2/forecasting/0a1e6f0a-1817-4a98-b02e-db8c9327d151"
+    document = json.loads(next(source.glob("log_map_archive_*.json")).read_text())
+    next(iter(document["lane_segments"].values()))["left_lane_boundary"] = value
+    path = tmp_path / "log_map_archive_x.json"
+    path.write_text(json.dumps(document))
+    with pytest.raises(UserError) as caught:
+        readers.read_map(path)
+    assert caught.value.one_line().startswith(f"{path}: ")
+
+
+def test_nan_stays_an_unknown_size_and_velocity():
+    """NaN means unknown where the data model allows it (z, sizes, velocities): real files use it."""
+    trace = readers.read_trace(SAMPLE)
+    assert np.isnan(trace.states.z).all()

@@ -9,6 +9,7 @@ its items must be picklable; the function must be defined at module level.
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
 import os
 import signal
@@ -52,16 +53,29 @@ def _serial(function: Callable[[Any], Any], items: Sequence[Any]) -> Iterator[tu
         yield number, function(item)
 
 
-def _ignore_interrupts() -> None:
-    """Workers leave Ctrl-C to the parent, which stops them after keeping what is done."""
+PR_SET_PDEATHSIG = 1
+"""Linux ``prctl`` option: the signal the kernel sends a process when its parent dies."""
+
+
+def _start_worker(parent: int) -> None:
+    """Workers leave Ctrl-C to the parent, which stops them after keeping what is done; and they
+    die with the parent ``parent`` (a pid), even when it is killed with SIGKILL: Linux sends them
+    SIGKILL then (``PR_SET_PDEATHSIG``). A parent gone before that was set up ends the worker here."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    libc = ctypes.CDLL(None, use_errno=True)
+    if libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) != 0:
+        raise OSError(ctypes.get_errno(), "prctl(PR_SET_PDEATHSIG) failed")
+    if os.getppid() != parent:
+        os._exit(1)
 
 
 def _processes(function: Callable[[Any], Any], items: Sequence[Any], jobs: int) -> Iterator[tuple[int, Any]]:
     """A pool of forked processes: they inherit what the parent has loaded (a compiled query).
     The workers start (fork) here, before the caller goes on to open files or databases."""
     context = multiprocessing.get_context("fork")
-    pool = ProcessPoolExecutor(min(jobs, len(items)), mp_context=context, initializer=_ignore_interrupts)
+    pool = ProcessPoolExecutor(
+        min(jobs, len(items)), mp_context=context, initializer=_start_worker, initargs=(os.getpid(),)
+    )
     pending = {pool.submit(function, item): number for number, item in enumerate(items)}
     return _completed(pool, pending)
 

@@ -12,12 +12,15 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # scenegrep uses no BLAS threads; idle ones spin on a core
 
 import argparse  # noqa: E402
+import errno  # noqa: E402
 import importlib  # noqa: E402
 import sys  # noqa: E402
+import warnings  # noqa: E402
 from collections.abc import Sequence
 
 from .. import __version__  # noqa: E402
 from ..errors import UserError  # noqa: E402
+from ..terminal import EscapingStream  # noqa: E402
 
 COMMANDS = ("export", "info", "ingest", "label", "report", "scenario", "scene", "serve", "show", "spre", "synth")
 """Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
@@ -49,7 +52,44 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one command line; returns the exit code."""
+    """Run one command line; returns the exit code. Text written to standard output and standard
+    error goes through :func:`scenegrep.terminal.printable`: names from data never reach a terminal
+    as escape sequences."""
+    warnings.filterwarnings("ignore", _FLOATING_POINT, RuntimeWarning)
+    stdout, stderr = sys.stdout, sys.stderr
+    sys.stdout = EscapingStream(stdout)  # type: ignore[assignment]
+    sys.stderr = EscapingStream(stderr, keep="\n\t\r")  # type: ignore[assignment]
+    try:
+        code = _run(argv)
+        stdout.flush()
+        return code
+    except OSError as exc:
+        if exc.errno not in _OUTPUT_ERRORS or exc.filename is not None:
+            raise
+        _discard_stdout()
+        print(f"scenegrep: error: <stdout>: cannot write: {exc.strerror}", file=sys.stderr)
+        return EXIT_USER_ERROR
+    finally:
+        sys.stdout, sys.stderr = stdout, stderr
+
+
+_FLOATING_POINT = "(invalid value|overflow|divide by zero) encountered"
+"""numpy's floating-point warnings: NaN or huge numbers in an input, which the data model then
+accepts (NaN: unknown) or refuses with a one-line error; never a warning's extra lines."""
+
+_OUTPUT_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO)
+"""Errors writing standard output that are the output's fault (disk full, quota, file too big)."""
+
+
+def _discard_stdout() -> None:
+    """Point standard output at /dev/null so that the interpreter's last flush of what is still
+    buffered does not fail again at exit."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.__stdout__.fileno())
+    os.close(devnull)
+
+
+def _run(argv: Sequence[str] | None) -> int:
     try:
         parser = build_parser()
         args = parser.parse_args(argv)

@@ -26,9 +26,14 @@ def asset(name: str) -> str:
     return resources.files(__package__).joinpath(f"assets/{name}").read_text(encoding="utf-8")
 
 
+_SCRIPT_ESCAPES = str.maketrans({"<": "\\u003c", ">": "\\u003e", "&": "\\u0026"})
+"""Characters that could end or change a ``<script>`` element (``</script>``, ``<!--``), written as
+JSON escapes: the parsed document is the same (``json.dumps`` already escapes U+2028 and U+2029)."""
+
+
 def script_json(document: Any) -> str:
-    """JSON safe to put inside a ``<script>`` element."""
-    return json.dumps(document, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+    """JSON safe to put inside a ``<script>`` element: no ``<``, ``>`` or ``&`` appears literally."""
+    return json.dumps(document, separators=(",", ":"), allow_nan=False).translate(_SCRIPT_ESCAPES)
 
 
 def html_page(title: str, style: str, body: str, attributes: dict[str, str] | None = None) -> str:

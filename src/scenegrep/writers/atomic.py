@@ -8,25 +8,39 @@ import tempfile
 from pathlib import Path
 from collections.abc import Iterator
 
+from ..errors import UserError, at, first_line
+
 
 @contextlib.contextmanager
 def atomic_path(target: str | Path) -> Iterator[Path]:
     """Yield a temporary path beside ``target``; on success it is fsynced, given the permissions
     of a newly created file (0666 less the umask) and renamed onto ``target`` in one step, on
-    failure it is removed."""
+    failure it is removed. A failure to write (disk full, read-only or missing permission) is a
+    one-line :class:`UserError` naming ``target``; ``target`` is then left as it was."""
     target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(fd)
+    with _writing(target):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+        os.close(fd)
+        try:
+            yield Path(tmp)
+            with open(tmp, "rb+") as handle:
+                os.fsync(handle.fileno())
+            os.chmod(tmp, 0o666 & ~_umask())
+            os.replace(tmp, target)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+
+
+@contextlib.contextmanager
+def _writing(target: Path) -> Iterator[None]:
+    """Turn an OSError raised while writing ``target`` into a :class:`UserError`."""
     try:
-        yield Path(tmp)
-        with open(tmp, "rb+") as handle:
-            os.fsync(handle.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, target)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        yield
+    except OSError as exc:
+        other = f" ({exc.filename})" if exc.filename and Path(exc.filename).parent != target.parent else ""
+        raise UserError(f"cannot write: {exc.strerror or first_line(exc)}{other}", at(target)) from None
 
 
 def _umask() -> int:

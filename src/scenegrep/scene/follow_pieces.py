@@ -87,6 +87,10 @@ class Pieces:
     ay: np.ndarray
     heading: np.ndarray
 
+    def take(self, index: np.ndarray) -> Pieces:
+        """The pieces at ``index``."""
+        return Pieces(*(getattr(self, k)[index] for k in ("row", "lo", "hi", "ax", "ay", "heading")))
+
 
 def linework(geometry: MapGeometry) -> Linework:
     """The map's linework, built once per geometry."""

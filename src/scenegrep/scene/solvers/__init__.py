@@ -36,27 +36,40 @@ from . import linear, smt
 from .branch_prune import BranchAndPrune, Outcome
 from .pointwise import satisfies
 from .problem import Bound, PointUnknown, Problem, build
-from .walk import find_walk, solve_walk
+from ..follow_pieces import Pieces
+from .walk import Walk, find_walk, solve_walk, walk_pieces
 
 
 def decide_rows(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
-    """Feasibility of every current row of the evaluator, one specialised system at a time."""
+    """Feasibility of every current row of the evaluator, one specialised system at a time (the
+    walks of rows that follow the road direction are enumerated for all rows at once)."""
     ok = np.zeros(ev.size, dtype=bool)
-    for row in range(ev.size):
-        outcome = solve(build(ev, group, tolerance, row), ev.geometry, tolerance)
+    problems = [build(ev, group, tolerance, row) for row in range(ev.size)]
+    walks = [find_walk(problem) if problem.unknowns else None for problem in problems]
+    pieces = walk_pieces(problems, walks, ev.geometry)
+    for row, problem in enumerate(problems):
+        outcome = solve(problem, ev.geometry, tolerance, walks[row], pieces.get(row))
         ev.notes[f"{outcome.solver}:{outcome.status}"] += 1
         ok[row] = outcome.feasible
     return ok
 
 
-def solve(problem: Problem, geometry: MapGeometry, tolerance: Tolerance) -> Outcome:
-    """Decide one specialised system (see the module docstring)."""
+def solve(
+    problem: Problem,
+    geometry: MapGeometry,
+    tolerance: Tolerance,
+    walk: Walk | None = None,
+    pieces: Pieces | None = None,
+) -> Outcome:
+    """Decide one specialised system (see the module docstring); ``walk`` and ``pieces`` are the
+    row's walk and its pieces when already found."""
     if not problem.unknowns:
         return Outcome("sat", {}, "direct") if satisfies(problem, geometry, {}) else Outcome("unsat", None, "direct")
     delta = max(tolerance.position, tolerance.heading)
-    walk = find_walk(problem)
+    walk = walk or find_walk(problem)
     if walk is not None:
-        return solve_walk(problem, geometry, walk, lambda piece, boxes: _solve_piece(piece, geometry, boxes, delta))
+        pieces = pieces or walk_pieces([problem], [walk], geometry)[0]
+        return solve_walk(problem, walk, pieces, lambda piece, boxes: _solve_piece(piece, geometry, boxes, delta))
     search = BranchAndPrune(problem, geometry, delta)
     box = search.initial_box()
     box = None if box is None else search.contract(box)

@@ -77,14 +77,23 @@ def _follow_terms(problem: Problem) -> list[Term]:
     return list(found)
 
 
+def walk_pieces(problems: list[Problem], walks: list[Walk | None], geometry: MapGeometry) -> dict[int, Pieces]:
+    """The pieces of every row's walk (problem index -> pieces), enumerated together."""
+    rows = [k for k, walk in enumerate(walks) if walk is not None]
+    if not rows:
+        return {}
+    ranges = np.array([problems[k].ranges[walks[k].distance] for k in rows], dtype=float)  # type: ignore[union-attr]
+    starts = np.array([(walks[k].x, walks[k].y) for k in rows], dtype=float)  # type: ignore[union-attr]
+    pieces = follow_pieces(geometry, ROAD_DIRECTION, starts[:, 0], starts[:, 1], ranges[:, 0], ranges[:, 1])
+    order = np.argsort(pieces.row, kind="stable")
+    bounds = np.searchsorted(pieces.row[order], np.arange(len(rows) + 1))
+    return {row: pieces.take(order[bounds[i] : bounds[i + 1]]) for i, row in enumerate(rows)}
+
+
 def solve_walk(
-    problem: Problem, geometry: MapGeometry, walk: Walk, solve_piece: Callable[[Problem, dict], Outcome]
+    problem: Problem, walk: Walk, pieces: Pieces, solve_piece: Callable[[Problem, dict], Outcome]
 ) -> Outcome:
     """Decide the row over every piece of its walk (see the module docstring)."""
-    lo, hi = problem.ranges[walk.distance]
-    pieces = follow_pieces(
-        geometry, ROAD_DIRECTION, np.array([walk.x]), np.array([walk.y]), np.array([lo]), np.array([hi])
-    )
     if len(problem.scalars) == 1 and not problem.conditions:
         try:
             return _solve_intervals(problem, walk, pieces)

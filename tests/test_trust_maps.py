@@ -210,3 +210,15 @@ def test_a_parquet_traces_map_path_is_relative_to_the_trace_never_the_working_di
     missing = "../Town01.xodr: no such file (expected a road map (opendrive))"  # not ./Town01.xodr
     assert code == 2 and err == [f"scenegrep: error: {missing}"]
     assert not marker.exists()
+
+
+def test_a_trace_path_of_a_named_format_must_be_a_regular_file(tmp_path):
+    """Even with its format named (as the dataset engine names it), a fifo is refused unread."""
+    from scenegrep import readers
+    from scenegrep.errors import UserError
+
+    os.mkfifo(tmp_path / "t.parquet")
+    with pytest.raises(
+        UserError, match=r"t\.parquet: not a regular file .*expected a trace file \(scenegrep-parquet\)"
+    ):
+        readers.read_trace(tmp_path / "t.parquet", "scenegrep-parquet")

@@ -7,6 +7,8 @@ import http.client
 import json
 import os
 import socket
+import subprocess
+import sys
 import threading
 import time
 from email.message import Message
@@ -26,6 +28,7 @@ from tests.view.conftest import fetch
 
 ADDRESS = "127.0.0.1:8765"
 SPRE = {"kind": "spre", "text": "[[:pedestrian:]]+", "options": {}}
+SCENE_PROGRAM = (REPO / "examples" / "scenes" / "fig3_car_ahead.scenic").read_text()
 SLOW = {
     "kind": "scenario",
     "text": (REPO / "examples" / "queries" / "s1_lane_change_stationary_car.scenic").read_text(),
@@ -234,3 +237,19 @@ def _living(group: int) -> list[str]:
         if int(fields[2]) == group and fields[0] != "Z":
             found.append(pid)
     return found
+
+
+def test_serve_compiles_scenic_programs_without_scenic_and_never_reaches_synth():
+    """The server and the query compilers load neither Scenic's compiler (which would run the
+    program's Python) nor scenegrep.synth (a fresh interpreter, so nothing else loaded them)."""
+    script = (
+        "import sys\n"
+        "import scenegrep.view.serve\n"
+        "from scenegrep.dataset.queries import QuerySpec, compiled\n"
+        f"compiled(QuerySpec.of('scene', {SCENE_PROGRAM!r}))\n"
+        f"compiled(QuerySpec.of('scenario', {SLOW['text']!r}, window='75'))\n"
+        "print(sorted(m for m in sys.modules if m.startswith(('scenic', 'scenegrep.synth'))))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=120)
+    assert done.returncode == 0 and done.stdout.strip() == "[]", done.stderr

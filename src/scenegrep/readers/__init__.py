@@ -164,8 +164,11 @@ def _malformed(path: str | Path, format_name: str) -> Iterator[None]:
 
 
 def read_traces(path: str | Path, format_name: str | None = None) -> Iterator[LabelTrace]:
-    """Every trace in a file or recording directory; a malformed input is a :class:`UserError`."""
+    """Every trace in a file or recording directory; a malformed input is a :class:`UserError`
+    (a path that is neither a directory, nor ``-`` for stdin, must be a regular file)."""
     name = _checked(path, format_name, "traces")
+    if str(path) != "-" and not Path(path).is_dir():
+        regular_file(path, f"a trace file ({name})")
     reader = module(name)
     with _malformed(path, name):
         if hasattr(reader, "read_traces"):

@@ -1,6 +1,7 @@
 """Hand-built labeled frames on the synthetic map of tests/model/maps.py, for scene-query tests.
 
-A frame is a dict ``id -> (class, x, y, heading[, length, width])``; the object named
+A frame is a dict ``id -> (class, x, y, heading[, length, width[, vx, vy]])`` (velocity in m/s,
+unknown when not given); the object named
 ``ego`` is the trace's ego. Cars default to 4.5 x 2 m, pedestrians to 0.75 x 0.75 m.
 """
 
@@ -26,11 +27,12 @@ def trace_of(*frames: dict) -> LabelTrace:
     rows = []
     for f, frame in enumerate(frames):
         for oid, spec in sorted(frame.items(), key=lambda item: ids.index(item[0])):
-            category, x, y, heading, *size = spec
-            length, width = size or SIZES[category]
-            rows.append((f, ids.index(oid), x, y, heading, length, width))
-    f, o, x, y, h, length, width = (np.array(column) for column in zip(*rows))
-    states = StateTable.build(f, o, x, y, h, length=length, width=width)
+            category, x, y, heading, *rest = spec
+            length, width = rest[:2] or SIZES[category]
+            vx, vy = rest[2:] or (math.nan, math.nan)
+            rows.append((f, ids.index(oid), x, y, heading, length, width, vx, vy))
+    f, o, x, y, h, length, width, vx, vy = (np.array(column) for column in zip(*rows))
+    states = StateTable.build(f, o, x, y, h, length=length, width=width, vx=vx, vy=vy)
     objects = ObjectTable.build(ids, [classes[i] for i in ids])
     n = len(frames)
     return LabelTrace.build(
@@ -41,7 +43,7 @@ def trace_of(*frames: dict) -> LabelTrace:
 def matches(program: str, *frames: dict, **options) -> list[bool]:
     """Which frames match the program (header added), on the synthetic map."""
     query = compile_scene(HEADER + program, "test.scenic", options.pop("visible_distance_compile", None))
-    tolerance = Tolerance(options.pop("position", 1e-6), options.pop("heading", 1e-6))
+    tolerance = Tolerance(options.pop("position", 1e-6), options.pop("heading", 1e-6), options.pop("speed", 1e-6))
     result = query.match(trace_of(*frames), MAP, SceneOptions(tolerance, **options))
     return result.matched.tolist()
 

@@ -62,6 +62,9 @@ def add_tolerance_arguments(parser: argparse.ArgumentParser) -> None:
         "--tolerance-position", type=float, metavar="M", help="position and size tolerance (m; default 1e-6)"
     )
     parser.add_argument("--tolerance-heading", type=float, metavar="RAD", help="heading tolerance (rad; default 1e-6)")
+    parser.add_argument(
+        "--tolerance-speed", type=float, metavar="M/S", help="speed and velocity tolerance (m/s; default 1e-6)"
+    )
 
 
 def tolerance_of(args: argparse.Namespace) -> Any:
@@ -69,7 +72,12 @@ def tolerance_of(args: argparse.Namespace) -> Any:
     instead of its value (unknown profiles and negative values are user errors)."""
     from ..scene.profiles import tolerance_of
 
-    return tolerance_of(args.tolerance_profile, position=args.tolerance_position, heading=args.tolerance_heading)
+    return tolerance_of(
+        args.tolerance_profile,
+        position=args.tolerance_position,
+        heading=args.tolerance_heading,
+        speed=args.tolerance_speed,
+    )
 
 
 def tolerance_options(args: argparse.Namespace) -> dict[str, Any]:
@@ -79,6 +87,7 @@ def tolerance_options(args: argparse.Namespace) -> dict[str, Any]:
         "tolerance_profile": args.tolerance_profile,
         "tolerance_position": args.tolerance_position,
         "tolerance_heading": args.tolerance_heading,
+        "tolerance_speed": args.tolerance_speed,
     }
 
 

@@ -49,6 +49,7 @@ OPTIONS: dict[str, dict[str, Any]] = {
         "tolerance_profile": None,
         "tolerance_position": None,
         "tolerance_heading": None,
+        "tolerance_speed": None,
         "visible_distance": None,
         "vocabulary": None,
         "all": False,
@@ -58,6 +59,7 @@ OPTIONS: dict[str, dict[str, Any]] = {
         "tolerance_profile": None,
         "tolerance_position": None,
         "tolerance_heading": None,
+        "tolerance_speed": None,
         "visible_distance": None,
         "exact": False,
         "explain": False,
@@ -147,6 +149,7 @@ def spec_tolerance(spec: QuerySpec) -> Any:
         spec.option("tolerance_profile"),
         position=spec.option("tolerance_position"),
         heading=spec.option("tolerance_heading"),
+        speed=spec.option("tolerance_speed"),
     )
 
 

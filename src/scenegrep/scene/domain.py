@@ -90,6 +90,42 @@ CLASSES: dict[str, ClassSpec] = {
     )
 }
 
+DYNAMIC_PROPERTIES = ("speed", "velocity", "angularSpeed")
+"""Scenic's dynamic properties a program may set ``with``: matched against the labels' velocities."""
+
+NO_EFFECT_PROPERTIES = ("color", "render", "showVisibleRegion")
+"""Scenic properties that only change how Scenic draws a scene: accepted, as they shape nothing."""
+
+UNMODELLED_PROPERTIES = {
+    "height": "heights are 3-D; queries are 2-D",
+    "pitch": "pitch is 3-D; queries are 2-D",
+    "roll": "roll is 3-D; queries are 2-D",
+    "orientation": "orientation is computed from parentOrientation and yaw; set heading or yaw",
+    "shape": "object shapes are boxes from the labels",
+    "baseOffset": "base offsets are 3-D",
+    "contactTolerance": "contact tolerances are 3-D (placement on surfaces)",
+    "sideComponentThresholds": "side surfaces are 3-D",
+    "onDirection": "placement on surfaces is 3-D",
+    "occluding": "visibility has no occlusion in 2-D queries",
+    "cameraOffset": "sensor offsets are not modelled",
+    "visionSensorOffset": "sensor offsets are not modelled",
+    "viewAngles": "3-D view angles are not modelled; set viewAngle",
+    "viewRayCount": "ray-traced visibility is not modelled",
+    "viewRayDensity": "ray-traced visibility is not modelled",
+    "viewRayDistanceScaling": "ray-traced visibility is not modelled",
+    "angularVelocity": "angular velocity vectors are not in the labels; angularSpeed is the 2-D one",
+    "sensors": "sensors are not modelled",
+    "observations": "sensor observations are not modelled",
+    "lastActions": "actions are not observed in labels",
+    "mutator": "mutation is not modelled",
+    "mutationScale": "mutation is not modelled",
+    "positionStdDev": "mutation is not modelled",
+    "headingStdDev": "mutation is not modelled",
+    "orientationStdDev": "mutation is not modelled",
+}
+"""Scenic 3.1.1 properties of Point, OrientedPoint, Object and the driving domain that shape a scene
+in ways queries do not model: setting one ``with`` is an error (never silently dropped)."""
+
 MODELS = (
     "scenic.domains.driving.model",
     "scenic.simulators.newtonian.driving_model",

@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import UserError, at
+from ..model import LabelTrace
 from ..model.geometry import heading_of_vector, normalize_angle
 from .geometry import MapGeometry
 from .program import TRACE, ProgramObject
@@ -29,9 +31,17 @@ class NotAffine(Exception):
     """A term is not linear in the unknowns (the caller falls back to a general solver)."""
 
 
+DYNAMIC_COLUMNS = {"vx": "vx", "vy": "vy", "speed": "speed", "angularSpeed": "angular_speed"}
+"""Dynamic features (m/s, rad/s) -> their :class:`Labels` column; NaN there means the trace lacks them."""
+
+
 @dataclass
 class Labels:
-    """Label state columns of one trace (indexed by state row) and its trace attributes."""
+    """Label state columns of one trace (indexed by state row) and its trace attributes.
+
+    ``vx``, ``vy`` and ``speed`` are in m/s, ``angular_speed`` in rad/s; NaN where the data has no
+    value. ``trace`` (when known) names the places of unknown values in errors.
+    """
 
     x: np.ndarray
     y: np.ndarray
@@ -39,6 +49,33 @@ class Labels:
     length: np.ndarray
     width: np.ndarray
     attributes: dict = field(default_factory=dict)
+    vx: np.ndarray | None = None
+    vy: np.ndarray | None = None
+    speed: np.ndarray | None = None
+    angular_speed: np.ndarray | None = None
+    trace: LabelTrace | None = None
+
+    def dynamic(self, obj: str, feature: str, states: np.ndarray) -> np.ndarray:
+        """Dynamic feature ``feature`` of program object ``obj`` at label state rows ``states``; a
+        :class:`UserError` naming the feature, the trace, the object and the frame if one is unknown."""
+        column = getattr(self, DYNAMIC_COLUMNS[feature])
+        values = np.full(len(states), np.nan) if column is None else column[states]
+        unknown = np.flatnonzero(np.isnan(values))
+        if len(unknown):
+            raise self._unknown(obj, feature, int(states[unknown[0]]))
+        return values
+
+    def _unknown(self, obj: str, feature: str, state: int) -> UserError:
+        if self.trace is None:
+            return UserError(f"{obj}.{feature} is unknown: the trace has no {feature}")
+        trace = self.trace
+        label = trace.objects.id[trace.states.object[state]]
+        frame = int(trace.frame_index[trace.states.frame[state]])
+        where = None if trace.source is None else at(trace.source.path)
+        message = (
+            f"{obj}.{feature} is unknown: trace {trace.name!r} has no {feature} for object {label!r} at frame {frame}"
+        )
+        return UserError(message, where)
 
 
 @dataclass
@@ -201,6 +238,8 @@ class Evaluator:
         if obj == TRACE:
             return np.full(self.size, self.labels.attributes[feature], dtype=object)
         states = self.rows.state[obj][self.origin]
+        if feature in DYNAMIC_COLUMNS:
+            return self.labels.dynamic(obj, feature, states)
         column = getattr(self.labels, feature)[states]
         if feature in ("width", "length"):
             column = np.where(np.isnan(column), self.objects[obj].default_size[feature], column)

@@ -123,9 +123,20 @@ def extend(rows: Rows, name: str, offsets: np.ndarray, candidates: np.ndarray) -
 
 
 def labels_of(trace: LabelTrace) -> Labels:
-    """The label columns the scene query reads."""
+    """The label columns the scene query reads (no data format scenegrep reads has angular speeds)."""
     states = trace.states
-    return Labels(states.x, states.y, states.heading, states.length, states.width, dict(trace.attributes))
+    return Labels(
+        states.x,
+        states.y,
+        states.heading,
+        states.length,
+        states.width,
+        dict(trace.attributes),
+        vx=states.vx,
+        vy=states.vy,
+        speed=states.speed(),
+        trace=trace,
+    )
 
 
 def match_trace(

@@ -22,12 +22,17 @@ TRACE = "@trace"
 POSITION_FEATURES = ("x", "y")
 HEADING_FEATURE = "heading"
 SIZE_FEATURES = ("width", "length")
+SPEED_FEATURES = ("speed", "vx", "vy")
+"""Features in m/s: the speed and the map-frame velocity components."""
+ANGULAR_SPEED_FEATURE = "angularSpeed"
 
 
 @dataclass(frozen=True, eq=False)
 class Feature:
     """Feature ``name`` of program object ``obj``: its defining ``term`` must equal the label's
-    value (``observed``) within the feature's tolerance; headings compare modulo 2π."""
+    value (``observed``) within the feature's tolerance; headings compare modulo 2π. Features are
+    x, y, heading and, when the program sets them ``with``, width, length, speed, vx, vy (velocity)
+    and angularSpeed."""
 
     obj: str
     name: str
@@ -46,9 +51,10 @@ class Feature:
 @dataclass(frozen=True, eq=False)
 class ProgramObject:
     """A scene object of the program: name (variable, ``ego``, or ``Class@line``), class, label
-    kinds it may match (None: any), features in order x, y, heading[, width, length], the
-    class defaults of its size (used when a label has none), and the behaviour call of its
-    ``with behavior`` specifier (None: no behaviour; only scenario queries read it)."""
+    kinds it may match (None: any), features in order x, y, heading[, width, length, speed,
+    angularSpeed, vx, vy], the class defaults of its size (used when a label has none), and the
+    behaviour call of its ``with behavior`` specifier (None: no behaviour; only scenario queries
+    read it)."""
 
     name: str
     class_name: str

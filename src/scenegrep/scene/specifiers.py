@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 from ..scenic import ir
 from . import expressions as E
 from . import vectors as V
-from .domain import CLASSES, Default, default_expression, defaulted_properties
+from .domain import CLASSES, UNMODELLED_PROPERTIES, Default, default_expression, defaulted_properties
 from .program import HEADING_FEATURE, Feature, ProgramObject, Requirement
 from .regions import (
     Difference,
@@ -214,11 +214,16 @@ def _add_scene_object(
         Feature(obj.name, "y", position.y, obj.observed["position"].y, node.span),
         Feature(obj.name, HEADING_FEATURE, obj.defining["heading"], obj.observed["heading"], node.span),
     ]
-    for size in ("width", "length"):
+    for size in ("width", "length", "speed", "angularSpeed"):
         effect = chosen.get(size)
         if effect is not None and effect.name == "with":
             value = E.to_num(r, obj.defining[size], effect.node)
             features.append(Feature(obj.name, size, value, obj.observed[size], effect.node.span))
+    effect = chosen.get("velocity")
+    if effect is not None:
+        velocity, observed = E.to_vec(r, obj.defining["velocity"], effect.node), obj.observed["velocity"]
+        features.append(Feature(obj.name, "vx", velocity.x, observed.x, effect.node.span))
+        features.append(Feature(obj.name, "vy", velocity.y, observed.y, effect.node.span))
     default_size = {}
     for size in ("width", "length"):
         default = r.evaluate_default(default_expression(obj.spec.name, size))  # type: ignore[arg-type]
@@ -307,6 +312,8 @@ def _op_node(node: ir.Specifier, i: int) -> ir.Node:
 
 def _with(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     prop = node.property or ""
+    if prop in UNMODELLED_PROPERTIES:
+        raise r.error(f"the property {prop!r} is not supported: {UNMODELLED_PROPERTIES[prop]}", node)
     if prop == "heading":
         return _facing(r, node, ops)
     if prop in ("position", "x", "y"):

@@ -78,7 +78,8 @@ class Instance:
 
 
 def observed_view(factory: TermFactory, name: str) -> dict[str, Any]:
-    """The observed leaves of scene object ``name``: position, heading, orientation, width, length."""
+    """The observed leaves of scene object ``name``: position, heading, orientation, width, length,
+    and the dynamic properties speed (m/s), velocity (m/s, map frame) and angularSpeed (rad/s)."""
     heading = factory.observed(name, "heading")
     return {
         "position": Vec(factory.observed(name, "x"), factory.observed(name, "y")),
@@ -86,6 +87,9 @@ def observed_view(factory: TermFactory, name: str) -> dict[str, Any]:
         "orientation": heading,
         "width": factory.observed(name, "width"),
         "length": factory.observed(name, "length"),
+        "speed": factory.observed(name, "speed"),
+        "velocity": Vec(factory.observed(name, "vx"), factory.observed(name, "vy")),
+        "angularSpeed": factory.observed(name, "angularSpeed"),
     }
 
 

@@ -109,6 +109,8 @@ class Adapter:
 
     # ---------------------------------------------------------------- helpers
     def span(self, node: ast.AST) -> ir.Span:
+        """The node's place; Scenic leaves some nodes (``override``) unplaced: then their first placed part's."""
+        node = next((n for n in ast.walk(node) if getattr(n, "lineno", None) is not None), node)
         line = getattr(node, "lineno", 1)
         column = getattr(node, "col_offset", 0) + 1
         end_line = getattr(node, "end_lineno", None) or line

@@ -16,7 +16,7 @@ model scenic.domains.driving.model
 #   road-or-shoulder containment as unknown on maps without shoulders.
 # - Run with --visible-distance 50, as in the paper.
 
-ego = new Car on lane, facing Range(150, 210) deg relative to roadDirection
+ego = new Car on network.laneRegion, facing Range(150, 210) deg relative to roadDirection
 require (distance from ego to intersection) > 0
 other = new Car on visible road, facing Range(-180, 180) deg
 require (distance to other) < 10

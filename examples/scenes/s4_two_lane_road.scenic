@@ -22,7 +22,7 @@ model scenic.domains.driving.model
 #   road-or-shoulder containment as unknown on maps without shoulders.
 # - Run with --visible-distance 50, as in the paper.
 
-ego = new Car on lane, facing Range(-15, 15) deg relative to roadDirection
+ego = new Car on network.laneRegion, facing Range(-15, 15) deg relative to roadDirection
 require (distance from ego to intersection) > 0
 sameWay = new Car offset by (Range(-1.5, 1.5), Range(-40, 40)), facing Range(-15, 15) deg relative to ego.heading
 oncoming1 = new Car offset by (Range(-8, -2), Range(-40, 40)), facing Range(165, 195) deg relative to ego.heading

@@ -17,6 +17,6 @@ model scenic.domains.driving.model
 #   road-or-shoulder containment as unknown on maps without shoulders.
 # - Run with --visible-distance 50, as in the paper.
 
-ego = new Car on lane, facing Range(-15, 15) deg relative to roadDirection
+ego = new Car on network.laneRegion, facing Range(-15, 15) deg relative to roadDirection
 cutIn = new Car offset by (Range(2.5, 5), Range(0, 15)), facing Range(10, 45) deg relative to ego.heading
 require not (cutIn.position in ego.lane)

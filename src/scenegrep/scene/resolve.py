@@ -44,7 +44,6 @@ NETWORK = {
 
 DRIVING_NAMES = {
     "road": MapRegion("drivable"),
-    "lane": MapRegion("lane"),
     "intersection": MapRegion("intersection"),
     "crossing": MapRegion("crossing"),
     "sidewalk": MapRegion("sidewalk"),
@@ -57,7 +56,9 @@ DRIVING_NAMES = {
     "everywhere": Everywhere(),
     "nowhere": Nowhere(),
 }
-"""Global names of the driving domain (``roadRegion`` as in Scenic's simulator models)."""
+"""Global names of the driving domain (``scenic/domains/driving/model.scenic``) and Scenic's
+``everywhere`` / ``nowhere``; ``crossing`` and ``roadRegion`` are extensions, named as in Scenic's
+webots and GTA world models."""
 
 
 class Resolver:

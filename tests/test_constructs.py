@@ -18,16 +18,17 @@ import shapely
 
 from scenegrep.errors import UserError
 from scenegrep.model import Area
-from scenegrep.scenario import compile_scenario
+from scenegrep.scenario import ScenarioOptions, compile_scenario
 from scenegrep.scene import SceneOptions, compile_scene
 from scenegrep.scene.domain import UNMODELLED_PROPERTIES
+from tests.scenario.worked_example import worked_map, worked_trace
 from tests.scene.frames import HEADER, MAP, trace_of
 
 ROOT = Path(__file__).parents[1]
 DATA = ROOT / "docs" / "scenic-constructs.toml"
 DOC = ROOT / "docs" / "scenic-constructs.md"
 FILENAME = "constructs.scenic"
-STATUSES = {"modelled", "rejected", "extension", "no effect"}
+STATUSES = {"modelled", "rejected", "extension", "no effect", "not observed"}
 CATEGORIES = ("specifier", "property", "operator", "statement", "name")
 TITLES = {
     "specifier": "Specifiers",
@@ -130,6 +131,21 @@ def test_local_path_names_a_file_beside_the_program(tmp_path):
         query.match(trace_of(*frames("dynamics")))
 
 
+def test_library_behaviour_arguments_are_not_observed():
+    """Labels name a primitive behaviour (FollowLane), not its intentions: Fig. 1 with other target
+    speeds and lane arguments finds the same windows on the worked example."""
+    text = (ROOT / "examples/queries/fig1_lane_change.scenic").read_text(encoding="utf-8")
+    changed = text.replace("target_speed=10", "target_speed=99").replace("self.laneSection._laneToLeft", "None")
+    assert changed.count("target_speed=99") == 3
+    answers = []
+    for program in (text, changed):
+        result = compile_scenario(program, FILENAME).match(
+            worked_trace(), 5, worked_map(), ScenarioOptions(find_all=True)
+        )
+        answers.append([(m.correspondence, m.starts.tolist()) for m in result.matches])
+    assert answers[0] == answers[1] and answers[0]
+
+
 def test_every_unmodelled_property_has_its_row():
     properties = {row["construct"].split(" ")[0] for row in rows() if row["category"] == "property"}
     assert set(UNMODELLED_PROPERTIES) <= properties
@@ -150,7 +166,10 @@ query, so every construct of a scene has the same status there):
 - **rejected**: an error naming the file and line:column, exit code 2 — never silently dropped;
 - **extension**: modelled, although Scenic 3.1.1 does not define it;
 - **no effect**: accepted, and Scenic gives it no effect there either (a scene is the initial
-  state, so behaviours do not shape it; colours only change drawings).
+  state, so behaviours do not shape it; colours only change drawings);
+- **not observed**: accepted, but labels cannot show it: the intentions of the driving
+  library's behaviours (`FollowLaneBehavior(target_speed=10)` is any FollowLane labelling,
+  whatever its target speed; seed 000's primitives are labels). The query admits every value.
 
 Names Scenic 3.1.1 does not define are errors, as in Scenic (a `NameError`), unless listed
 as extensions. Dynamic properties (`speed`, `velocity`, `angularSpeed`) are matched against the

@@ -20,9 +20,10 @@ from scenegrep.errors import UserError
 from scenegrep.model import BehaviourLabels
 from scenegrep.readers.av2_forecasting import read_trace
 from scenegrep.scenario import ScenarioOptions, compile_scenario
-from scenegrep.scene import SceneOptions, compile_scene
+from scenegrep.scene import SceneOptions, Tolerance, compile_scene
+from scenegrep.scene.misses import nearest_miss
 from scenegrep.writers.trace_json import write_trace_json
-from tests.scene.frames import HEADER, matches, trace_of
+from tests.scene.frames import HEADER, MAP, matches, trace_of
 
 MOVING = ("Car", 1.75, 20.0, 0.0, 4.5, 2.0, 0.0, 10.0)  # northbound at 10 m/s
 DRIFTING = ("Car", 1.75, 20.0, 0.0, 4.5, 2.0, 6.0, 8.0)  # 10 m/s, but not along the heading
@@ -52,6 +53,14 @@ def test_the_speed_tolerance_admits_speeds_within_it():
     assert matches(program, {"ego": MOVING}) == [False]
     assert matches(program, {"ego": MOVING}, speed=0.1) == [True]
     assert matches(program, {"ego": MOVING}, position=1.0, heading=1.0) == [False]  # not the other tolerances
+
+
+def test_a_nearest_miss_names_the_speed_tolerance_that_admits_it():
+    query = compile_scene(HEADER + "ego = new Car at (1.75, 20), facing 0 deg, with speed 12.5\n")
+    result = query.match(trace_of({"ego": MOVING}), MAP, SceneOptions())
+    miss = nearest_miss(result, np.array([0]))
+    assert [(s.name, s.value) for s in miss.needed] == [("speed", pytest.approx(2.5, rel=1e-3))]
+    assert query.match(trace_of({"ego": MOVING}), MAP, SceneOptions(miss.tolerance(Tolerance()))).matched[0]
 
 
 @pytest.mark.parametrize(

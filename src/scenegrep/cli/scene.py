@@ -56,7 +56,7 @@ def add_tolerance_arguments(parser: argparse.ArgumentParser) -> None:
         "--tolerance-profile",
         metavar="NAME",
         help=f"tolerances measured on a dataset's labels ({', '.join(PROFILES)}; default exact); "
-        "--tolerance-position and --tolerance-heading override its values",
+        "--tolerance-position, --tolerance-heading and --tolerance-speed override its values",
     )
     parser.add_argument(
         "--tolerance-position", type=float, metavar="M", help="position and size tolerance (m; default 1e-6)"

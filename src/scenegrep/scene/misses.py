@@ -32,11 +32,11 @@ from .match import TraceMatches, match_trace
 if TYPE_CHECKING:
     from .query import SceneResult
 
-SCALES = {"position": 1.0, "heading": 0.1}
-"""How much of each tolerance one unit of the ray parameter adds (m, rad): 1 m per 0.1 rad."""
-CAPS = {"position": 20.0, "heading": math.pi}
-"""The largest tolerance a miss may need (m, rad): a heading tolerance of π admits any heading."""
-UNITS = {"position": "m", "heading": "rad"}
+SCALES = {"position": 1.0, "heading": 0.1, "speed": 1.0}
+"""How much of each tolerance one unit of the ray parameter adds (m, rad, m/s): 1 m per 0.1 rad per 1 m/s."""
+CAPS = {"position": 20.0, "heading": math.pi, "speed": 30.0}
+"""The largest tolerance a miss may need (m, rad, m/s): a heading tolerance of π admits any heading."""
+UNITS = {"position": "m", "heading": "rad", "speed": "m/s"}
 RAY_CAP = max(CAPS[name] / SCALES[name] for name in CAPS)
 """The ray parameter at which every tolerance reaches its cap."""
 RAY_FLOOR = 1e-7

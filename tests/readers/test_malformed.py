@@ -96,6 +96,23 @@ def test_an_empty_av2_annotation_table_is_refused(real_data, tmp_path):
     assert _error(log) == f"{annotations}: holds no rows"
 
 
+def test_a_corrupt_feather_string_offset_is_refused_not_an_abort(real_data, tmp_path):
+    """Feather buffers are used where they lie: a bit flip in a string column's offsets made Arrow
+    allocate without bound (std::bad_alloc, an abort) when the column was converted."""
+    log = tmp_path / "log"
+    shutil.copytree(real_data / "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede", log)
+    annotations = log / "annotations.feather"
+    annotations.chmod(0o644)
+    table = feather.read_table(annotations)
+    column = table.column("track_uuid").combine_chunks()
+    offsets = np.frombuffer(column.buffers()[1], np.int32).copy()
+    offsets[2] = -2_000_000_000
+    broken = pa.Array.from_buffers(pa.string(), len(column), [None, pa.py_buffer(offsets), column.buffers()[2]])
+    table = table.set_column(table.column_names.index("track_uuid"), "track_uuid", broken)
+    feather.write_feather(table, annotations, compression="uncompressed")
+    assert "non-monotonic offset" in _error(log)
+
+
 def test_duplicate_track_ids_of_different_types_are_refused(real_data, tmp_path):
     source = real_data / "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0757.pkl"
     scenario = RestrictedUnpickler(io.BytesIO(source.read_bytes())).load()

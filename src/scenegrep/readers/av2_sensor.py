@@ -60,6 +60,7 @@ def is_log(directory: Path) -> bool:
 def _columns(path: Path, names: tuple[str, ...]) -> dict[str, np.ndarray]:
     with reading(path, "Argoverse 2 feather file", pa.ArrowException):
         table = feather.read_table(path)
+        table.validate(full=True)  # Feather buffers are used as they lie: a bad offset crashes Arrow later
     missing = [n for n in names if n not in table.column_names]
     if missing:
         raise UserError(f"missing column(s) {', '.join(missing)}", at(path))

@@ -182,3 +182,14 @@ def test_the_parser_loads_without_importing_scenic():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_the_adapter_reads_every_field_of_the_scenic_nodes_it_maps():
+    """A field the adapter did not read would be a silently dropped operand: each Scenic specifier and
+    operator node class it maps lists exactly the node's fields."""
+    import scenic.syntax.ast as scenic_ast
+
+    from scenegrep.scenic.adapter import _OPERATOR_FIELDS, _SPECIFIER_FIELDS
+
+    for kind, (_, fields) in {**_SPECIFIER_FIELDS, **_OPERATOR_FIELDS}.items():
+        assert set(getattr(scenic_ast, kind)._fields) == set(fields), kind

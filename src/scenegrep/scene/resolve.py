@@ -111,6 +111,7 @@ class Resolver:
             raise self.error(f"{type(node).__name__} statements are not supported", node)
 
     def param(self, node: ir.Param) -> None:
+        self.check_map_setting(node)
         value = self.evaluate(node.value, name=None)
         if node.name == "map":
             if not (isinstance(value, Term) and value.kind == "str"):
@@ -123,6 +124,16 @@ class Resolver:
             equal = self.f.op("eq", value, observed, kind="bool")
             text = f"param {node.name} equals the trace's attribute {node.name}"
             self.scene.requirements.append(Requirement(equal, text, node.span, parameter=node.name))
+
+    def check_map_setting(self, node: ir.Param) -> None:
+        """Scenic's map settings queries cannot honour are errors: ``map_options`` (Scenic's map
+        loader's options; maps are read with its defaults) unless empty, ``use2DMap`` unless True
+        (Scenic refuses 3-D maps)."""
+        empty = isinstance(node.value, ir.Mapping) and not node.value.keys
+        if node.name == "map_options" and not empty:
+            raise self.error("param map_options is not supported: maps are read with Scenic's default options", node)
+        if node.name == "use2DMap" and node.value != ir.Constant(True):
+            raise self.error("param use2DMap must be True: queries are 2-D (Scenic supports no 3-D maps)", node)
 
     def assign(self, node: ir.Assign) -> None:
         if node.name in DRIVING_NAMES or node.name in ("network", "globalParameters", "self"):

@@ -21,10 +21,10 @@ over the vehicles (cars, trucks, buses, trailers, motorcycles) and the ego:
 It prints the median and the 90th, 95th and 99th percentiles of each per dataset, and the
 profile they give (:data:`scenegrep.scene.profiles.PROFILES` holds these values, documented in
 the README): heading = the 90th percentile of ``heading_vs_lane``, position = the largest 90th
-percentile of ``axis_offset``, ``position_jitter`` and ``size_deviation``, each rounded up to two
-significant digits. So each tolerance admits 90 % of the real deviations from what Scenic's
-defaults make exact (a car's heading on a road; a car ``ahead of`` another on its axis) and of the
-labels' own noise.
+percentile of ``axis_offset``, ``position_jitter`` and ``size_deviation``, speed = the 90th
+percentile of ``velocity_vs_track``, each rounded up to two significant digits. So each tolerance
+admits 90 % of the real deviations from what Scenic's defaults make exact (a car's heading on a
+road; a car ``ahead of`` another on its axis) and of the labels' own noise.
 
     python benchmarks/label_noise.py [--json results.json]
 """
@@ -219,7 +219,8 @@ def profile(samples: dict[str, np.ndarray]) -> dict[str, float]:
     significant digits."""
     position = max(np.percentile(samples[name], PROFILE_PERCENTILE) for name in POSITION_MEASURES)
     heading = np.percentile(samples["heading_vs_lane"], PROFILE_PERCENTILE)
-    return {"position": round_up(float(position)), "heading": round_up(float(heading))}
+    speed = np.percentile(samples["velocity_vs_track"], PROFILE_PERCENTILE)
+    return {"position": round_up(float(position)), "heading": round_up(float(heading)), "speed": round_up(float(speed))}
 
 
 def round_up(value: float) -> float:

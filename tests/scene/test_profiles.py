@@ -28,9 +28,10 @@ TRACE = trace_of({"ego": ("Car", 3.0, 30.0, 0.06)})
 
 def test_a_profile_gives_its_values_and_given_tolerances_replace_them():
     assert tolerance_of() == Tolerance() == PROFILES["exact"]
-    assert tolerance_of("nuscenes") == PROFILES["nuscenes"] == Tolerance(1.4, 0.084)
-    assert tolerance_of("nuscenes", heading=0.5, position=None) == Tolerance(1.4, 0.5)
-    assert tolerance_of(None, position=0.2) == Tolerance(0.2, 1e-6)
+    assert tolerance_of("nuscenes") == PROFILES["nuscenes"] == Tolerance(1.4, 0.084, 0.011)
+    assert tolerance_of("nuscenes", heading=0.5, position=None) == Tolerance(1.4, 0.5, 0.011)
+    assert tolerance_of("waymo", speed=2.0) == Tolerance(0.83, 0.049, 2.0)
+    assert tolerance_of(None, position=0.2) == Tolerance(0.2, 1e-6, 1e-6)
 
 
 @pytest.mark.parametrize(

@@ -153,6 +153,25 @@ def test_a_label_off_the_walk_or_facing_away_does_not_match():
     assert not match(1.75, 2.0, 31.0, 40.0, (ex, ey, end_heading(ex, ey)))[0]
 
 
+def test_a_requirement_on_the_followed_car_is_decided_on_each_piece():
+    """A requirement on D itself sends each piece, rewritten, to the general solvers."""
+    program = (
+        "ego = new Car on road\nd = Range(10, 30)\nc = new Car following roadDirection from ego for d\nrequire d > 20"
+    )
+    query = compile_scene(HEADER + program, "follow.scenic")
+    options = SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"})
+    answers = []
+    for d in (15.0, 25.0):
+        ex, ey = reference_follow(1.75, 2.0, d)
+        trace = trace_of({"ego": ("Car", 1.75, 2.0, 0.0), "c": ("Car", ex, ey, end_heading(ex, ey))})
+        result = query.match(trace, MAP, options)
+        answers.append(bool(result.matched[0]))
+        if result.matched[0]:
+            witness = next(v for k, v in result.values(0).items() if k.startswith("Range"))
+            assert abs(witness - d) <= 1e-5
+    assert answers == [False, True]
+
+
 @pytest.mark.real_data
 @pytest.mark.parametrize("town", ["Town01", "Town06"])
 def test_the_pieces_of_carla_towns_hold_every_walk(town, maps_dir):

@@ -383,41 +383,44 @@ class MapGeometry:
         the lane containing the point; outside every lane the nearest lane; outside the road network
         0. Exact on OpenDRIVE maps, whose intersections keep Scenic's maneuver order.
         """
-        rows, headings = self.field_values(field, x, y, value)
-        first = np.ones(len(rows), dtype=bool)
-        first[1:] = rows[1:] != rows[:-1]
+        if not (isinstance(field, MapField) and field.name == "lanes"):
+            rows, headings = self.field_values(field, x, y, value)
+            chosen = np.zeros(len(x))
+            chosen[rows[_firsts(rows)]] = headings[_firsts(rows)]
+            return chosen
+        road_map = self._require_map()
+        rows, lanes = road_map.lanes_containing(x, y)
+        lane = np.full(len(x), -1, dtype=np.intp)
+        lane[rows[_firsts(rows)]] = lanes[_firsts(rows)]
+        if len(x):
+            self._intersection_choice(x, y, lane)
         chosen = np.zeros(len(x))
-        chosen[rows[first]] = headings[first]
-        if isinstance(field, MapField) and field.name == "lanes" and len(x):
-            self._intersection_choice(x, y, chosen)
+        on = np.flatnonzero(lane >= 0)
+        chosen[on] = road_map.centreline_polylines.direction_at(lane[on], x[on], y[on])
         return chosen
 
-    def _intersection_choice(self, x: np.ndarray, y: np.ndarray, chosen: np.ndarray) -> None:
-        """Points in an intersection area take the direction of the first of its lanes containing
-        them, else of the nearest (the first intersection area holding the point counts)."""
+    def _intersection_choice(self, x: np.ndarray, y: np.ndarray, lane: np.ndarray) -> None:
+        """Points in an intersection area take the first of its lanes containing them, else the
+        nearest (the first intersection area holding the point counts): set in ``lane``."""
         road_map = self._require_map()
         tree, flat, starts = self._intersection_areas
         if not len(flat):
             return
         points = shapely.points(x, y)
         point, area = tree.query(points, predicate="intersects")
-        order = np.lexsort((area, point))
-        point, area = point[order], area[order]
-        first = np.ones(len(point), dtype=bool)
-        first[1:] = point[1:] != point[:-1]
-        point, area = point[first], area[first]
+        point, area = _first_per_point(point, area)
         counts = starts[area + 1] - starts[area]
         group = np.repeat(np.arange(len(point)), counts)
         position = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-        lane = flat[starts[area][group] + position]
+        candidates = flat[starts[area][group] + position]
         here = points[point[group]]
-        score = np.where(shapely.intersects(road_map.lane_polygons[lane], here), -1.0, 0.0)
-        outside = score == 0
-        score[outside] = shapely.distance(road_map.lane_polygons[lane[outside]], here[outside])
+        score = np.where(shapely.intersects(road_map.lane_polygons[candidates], here), -1.0, 0.0)
+        outside = np.flatnonzero(score == 0)
+        outside = outside[~np.isin(group[outside], group[score < 0])]
+        score[outside] = shapely.distance(road_map.lane_polygons[candidates[outside]], here[outside])
         order = np.lexsort((position, score, group))
-        best = order[np.r_[True, group[order][1:] != group[order][:-1]]] if len(order) else order
-        rows = point[group[best]]
-        chosen[rows] = road_map.centreline_polylines.direction_at(lane[best], x[rows], y[rows])
+        best = order[_firsts(group[order])]
+        lane[point[group[best]]] = candidates[best]
 
     def field_headings_in_box(
         self, field: Field, x0: float, x1: float, y0: float, y1: float, value: Values
@@ -473,6 +476,21 @@ WIDE_BOX_M = 10.0
 SMALL_BOX_M = 0.01
 """Boxes with a half-diagonal up to this (m) whose corners and centre all take the same headings
 are taken to lie in one cell of the field (cells are convex at that scale)."""
+
+
+def _firsts(rows: np.ndarray) -> np.ndarray:
+    """Whether each entry of a sorted array is the first of its value."""
+    first = np.ones(len(rows), dtype=bool)
+    first[1:] = rows[1:] != rows[:-1]
+    return first
+
+
+def _first_per_point(point: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For (point, area) pairs, each point's lowest area, points ascending."""
+    order = np.lexsort((area, point))
+    point, area = point[order], area[order]
+    first = _firsts(point)
+    return point[first], area[first]
 
 
 def _off_lane(road_map: RoadMap, x, y, missing, rows, headings) -> tuple[np.ndarray, np.ndarray]:

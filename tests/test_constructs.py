@@ -177,9 +177,10 @@ velocities of the labels within `--tolerance-speed` (m/s); where a trace has no 
 object a query needs, the answer is unknown, and the query stops with a one-line error naming
 the feature, the trace, the object and the frame (never "true"). No data format scenegrep
 reads has angular speeds, so `angularSpeed` is always unknown. AV2 sensor logs record no
-velocities: their reader derives them from the positions by finite differences within each
-track, so speeds there are estimates; every other reader gives the velocities the data records
-(AV2 forecasting, Waymo, ScenarioNet, CommonRoad, scenegrep's JSON and Parquet traces), or none.
+velocities either: their reader estimates them from positions (for SpRE and the viewer), and
+queries treat those estimates as unknown, not as labels. The other readers give the velocities
+the data records (AV2 forecasting, Waymo, ScenarioNet, CommonRoad, scenegrep's JSON and Parquet
+traces), or none.
 
 Each row is tested by `tests/test_constructs.py`: modelled rows run a query that depends on
 the construct on hand-built frames and check the answer worked out by hand; rejected rows

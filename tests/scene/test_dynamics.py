@@ -19,6 +19,7 @@ from scenegrep.cli.main import main
 from scenegrep.errors import UserError
 from scenegrep.model import BehaviourLabels
 from scenegrep.readers.av2_forecasting import read_trace
+from scenegrep.readers.av2_sensor import read_trace as read_sensor_log
 from scenegrep.scenario import ScenarioOptions, compile_scenario
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
 from scenegrep.scene.misses import nearest_miss
@@ -67,9 +68,9 @@ def test_a_nearest_miss_names_the_speed_tolerance_that_admits_it():
     ("program", "feature"),
     [
         ("ego = new Car with speed Range(13.9, 40)\n", "ego.speed"),
-        ("ego = new Car with velocity (0, 10)\n", "ego.vx"),
+        ("ego = new Car with velocity (0, 10)\n", "ego.velocity"),
         ("ego = new Car\nrequire ego.speed < 100\n", "ego.speed"),
-        ("ego = new Car\nother = new Car ahead of ego\nrequire other.velocity.y < 100\n", "other.vy"),
+        ("ego = new Car\nother = new Car ahead of ego\nrequire other.velocity.y < 100\n", "other.velocity"),
     ],
 )
 def test_an_unknown_velocity_is_an_error_never_true(program, feature):
@@ -155,3 +156,19 @@ def test_speed_in_a_scenario_guard_and_require_on_a_real_recording(recording):
     query = compile_scenario(HEADER + SCENARIO, "go.scenic")
     result = query.match(labeled, window, None, ScenarioOptions(find_all=True))
     assert [(m.correspondence, m.starts.tolist()) for m in result.matches] == [({"ego": "AV"}, expected)]
+
+
+def test_velocities_a_reader_estimated_are_unknown():
+    """AV2 sensor logs record no velocities; the reader's finite differences are not labels."""
+    log = AV2.parents[1] / "sensor" / "7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
+    if not log.exists():
+        pytest.skip("../shared/real_data is not here")
+    trace = read_sensor_log(log)
+    assert not np.isnan(trace.states.vx).all()  # the reader did estimate them (for SpRE and the viewer)
+    query = compile_scene(HEADER + ANYWHERE + ", with speed Range(3, 5)\n", "speed.scenic")
+    with pytest.raises(UserError) as caught:
+        query.match(trace, None, SceneOptions())
+    assert caught.value.one_line() == (
+        f"{log}: ego.speed is unknown: trace '{log.name}' has no speed for object 'ego' at frame 0"
+        " (the data records none; the reader's estimates from positions are not labels)"
+    )

@@ -10,6 +10,11 @@ from .geometry import heading_difference, heading_of_vector
 from .states import StateTable
 
 
+ESTIMATED_VELOCITY = "velocity_estimated_from"
+"""Trace attribute of a reader that fills velocities the data lacks by :func:`with_derived_velocity`
+(its value says from what): queries treat such velocities as unknown, never as labels."""
+
+
 def track_order(states: StateTable) -> np.ndarray:
     """Permutation of state rows that groups them by object, in frame order within an object."""
     return np.lexsort((states.frame, states.object))

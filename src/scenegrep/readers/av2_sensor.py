@@ -8,7 +8,8 @@ length/width/height_m, box rotation qw..qz and centre tx..tz_m in the *ego* fram
 of their timestamp: ``city = R_ego · box + t_ego``. Every annotation timestamp is a
 frame; frame times are seconds since the first. The ego vehicle becomes object
 ``ego`` (class REGULAR_VEHICLE, size :data:`EGO_SIZE_M`). Velocities come from
-finite differences of positions (the log has none).
+finite differences of positions (the log has none); the trace attribute
+:data:`~scenegrep.model.kinematics.ESTIMATED_VELOCITY` says so, and queries treat them as unknown.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import pyarrow.feather as feather
 from ..errors import UserError, at
 from ..model import LabelTrace, MapSource, ObjectTable, StateTable, TraceSource
 from ..model.geometry import heading_from_yaw, rotation_matrices
-from ..model.kinematics import with_derived_velocity
+from ..model.kinematics import ESTIMATED_VELOCITY, with_derived_velocity
 from .av2_map import FORMAT as MAP_FORMAT
 from .av2_map import find_map
 from .common import reading
@@ -112,7 +113,12 @@ def read_trace(directory: str | Path) -> LabelTrace:
         objects,
         states,
         ego=EGO_ID,
-        attributes={"dataset": "argoverse2-sensor", "log_id": directory.name, "time_origin_ns": int(stamps[0])},
+        attributes={
+            "dataset": "argoverse2-sensor",
+            "log_id": directory.name,
+            "time_origin_ns": int(stamps[0]),
+            ESTIMATED_VELOCITY: "positions",
+        },
         source=TraceSource(str(directory), FORMAT),
         map_source=None if map_path is None else MapSource(str(map_path), MAP_FORMAT),
     )

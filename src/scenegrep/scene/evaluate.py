@@ -21,6 +21,7 @@ import numpy as np
 from ..errors import UserError, at
 from ..model import LabelTrace
 from ..model.geometry import heading_of_vector, normalize_angle
+from ..model.kinematics import ESTIMATED_VELOCITY
 from .geometry import MapGeometry
 from .program import TRACE, ProgramObject
 from .regions import Region
@@ -33,6 +34,8 @@ class NotAffine(Exception):
 
 DYNAMIC_COLUMNS = {"vx": "vx", "vy": "vy", "speed": "speed", "angularSpeed": "angular_speed"}
 """Dynamic features (m/s, rad/s) -> their :class:`Labels` column; NaN there means the trace lacks them."""
+_FEATURE_NAMES = {"vx": "velocity", "vy": "velocity"}
+"""The Scenic property a feature is part of, for messages."""
 
 
 @dataclass
@@ -67,14 +70,17 @@ class Labels:
 
     def _unknown(self, obj: str, feature: str, state: int) -> UserError:
         if self.trace is None:
-            return UserError(f"{obj}.{feature} is unknown: the trace has no {feature}")
+            name = _FEATURE_NAMES.get(feature, feature)
+            return UserError(f"{obj}.{name} is unknown: the trace has no {name}")
         trace = self.trace
         label = trace.objects.id[trace.states.object[state]]
         frame = int(trace.frame_index[trace.states.frame[state]])
         where = None if trace.source is None else at(trace.source.path)
-        message = (
-            f"{obj}.{feature} is unknown: trace {trace.name!r} has no {feature} for object {label!r} at frame {frame}"
-        )
+        name = _FEATURE_NAMES.get(feature, feature)
+        message = f"{obj}.{name} is unknown: trace {trace.name!r} has no {name} for object {label!r} at frame {frame}"
+        estimated = trace.attributes.get(ESTIMATED_VELOCITY)
+        if estimated is not None and name != "angularSpeed":
+            message += f" (the data records none; the reader's estimates from {estimated} are not labels)"
         return UserError(message, where)
 
 

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import LabelTrace
+from ..model.kinematics import ESTIMATED_VELOCITY
 from .decide import Tolerance, decide
 from .dependencies import Group
 from .evaluate import Evaluator, Labels, Rows
@@ -123,8 +124,10 @@ def extend(rows: Rows, name: str, offsets: np.ndarray, candidates: np.ndarray) -
 
 
 def labels_of(trace: LabelTrace) -> Labels:
-    """The label columns the scene query reads (no data format scenegrep reads has angular speeds)."""
+    """The label columns the scene query reads: velocities only where the data records them (not
+    those a reader estimated), and no angular speeds (no data format scenegrep reads has them)."""
     states = trace.states
+    recorded = ESTIMATED_VELOCITY not in trace.attributes
     return Labels(
         states.x,
         states.y,
@@ -132,9 +135,9 @@ def labels_of(trace: LabelTrace) -> Labels:
         states.length,
         states.width,
         dict(trace.attributes),
-        vx=states.vx,
-        vy=states.vy,
-        speed=states.speed(),
+        vx=states.vx if recorded else None,
+        vy=states.vy if recorded else None,
+        speed=states.speed() if recorded else None,
         trace=trace,
     )
 

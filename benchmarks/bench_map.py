@@ -56,9 +56,10 @@ def scenic_lane_at_us(path: Path, road_map: RoadMap, rng: np.random.Generator) -
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         from scenic.core.vectors import Vector
-        from scenic.domains.driving.roads import Network
 
-        network = Network.fromFile(str(path), useCache=False, writeCache=False)
+        from scenegrep.readers.opendrive import parse_network
+
+        network = parse_network(path)
     x0, y0, x1, y1 = road_map.bounds()
     points = [Vector(a, b) for a, b in zip(rng.uniform(x0, x1, 2000), rng.uniform(y0, y1, 2000))]
     return median_seconds(lambda: [network.laneAt(p) for p in points], 3) / len(points)

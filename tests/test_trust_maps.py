@@ -222,3 +222,15 @@ def test_a_trace_path_of_a_named_format_must_be_a_regular_file(tmp_path):
         UserError, match=r"t\.parquet: not a regular file .*expected a trace file \(scenegrep-parquet\)"
     ):
         readers.read_trace(tmp_path / "t.parquet", "scenegrep-parquet")
+
+
+def test_without_a_writable_cache_scenic_reads_the_xodr_with_its_snet_cache_off(planted, monkeypatch):
+    """The fallback never lets Scenic's ``Network.fromFile`` look at a ``.snet``."""
+    from scenegrep.synth._scenic import NO_SNET, map_params
+
+    folder, _ = planted
+    (folder / "not-a-folder").write_text("")
+    monkeypatch.setenv("SCENEGREP_CACHE", str(folder / "not-a-folder"))
+    params = map_params(folder / "Town01.xodr")
+    assert params == {"map": str(folder / "Town01.xodr"), "map_options": NO_SNET}
+    assert NO_SNET == {"useCache": False, "writeCache": False}

@@ -3,14 +3,18 @@ error messages, body lengths, half-sent requests and the time limit of a query."
 
 from __future__ import annotations
 
+import contextlib
 import http.client
 import json
 import os
+import re
+import signal
 import socket
 import subprocess
 import sys
 import threading
 import time
+import urllib.request
 from email.message import Message
 from http import HTTPStatus
 from pathlib import Path
@@ -253,3 +257,63 @@ def test_serve_compiles_scenic_programs_without_scenic_and_never_reaches_synth()
     env = {**os.environ, "PYTHONPATH": str(REPO / "src")}
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=120)
     assert done.returncode == 0 and done.stdout.strip() == "[]", done.stderr
+
+
+def test_stopping_the_server_stops_a_running_query(real_dataset):
+    """Ctrl-C reaches the server only (queries lead their own process groups): it kills them."""
+    server = subprocess.Popen(
+        [sys.executable, "-m", "scenegrep", "serve", str(real_dataset), "--port", "0", "-j", "2"],
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(REPO / "src")},
+    )
+    try:
+        url = re.search(r"http://127\.0\.0\.1:\d+/", server.stdout.readline()).group(0)
+        page = urllib.request.urlopen(url, timeout=30).read().decode()
+        token = re.search(r'data-token="([^"]+)"', page).group(1)
+        headers = {"X-Scenegrep-Token": token, "Content-Type": "application/json"}
+        request = urllib.request.Request(url + "api/query", json.dumps(SLOW).encode(), headers)
+        threading.Thread(
+            target=lambda: _ignore_errors(urllib.request.urlopen, request, timeout=60), daemon=True
+        ).start()
+        deadline = time.monotonic() + 20
+        while len(_descendants(server.pid)) < 3 and time.monotonic() < deadline:  # fork server, query, workers
+            time.sleep(0.1)
+        started = _descendants(server.pid)
+        assert len(started) >= 3
+    finally:
+        stopping = time.monotonic()
+        server.send_signal(signal.SIGINT)
+        server.wait(timeout=60)
+    assert time.monotonic() - stopping < 3.0, "the server waited for the query"
+    deadline = time.monotonic() + 5
+    while [p for p in started if _alive(p)] and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert [p for p in started if _alive(p)] == []
+
+
+def _ignore_errors(function, *args, **kwargs) -> None:
+    with contextlib.suppress(OSError):
+        function(*args, **kwargs)
+
+
+def _stat(pid: str) -> list[str] | None:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return None
+
+
+def _descendants(root: int) -> set[str]:
+    """The processes below ``root`` (from /proc)."""
+    parents = {pid: fields[1] for pid in filter(str.isdigit, os.listdir("/proc")) if (fields := _stat(pid))}
+    found, frontier = set(), {str(root)}
+    while frontier:
+        frontier = {pid for pid, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def _alive(pid: str) -> bool:
+    fields = _stat(pid)
+    return fields is not None and fields[0] != "Z"

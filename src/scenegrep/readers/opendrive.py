@@ -175,6 +175,6 @@ def read_map(path: str | Path, key: str | None = None) -> RoadMap:
     if cached.is_file():
         return replace(read_cached(cached), source=str(path))
     road_map = convert_network(parse_network(path), path.stem, str(path))
-    with contextlib.suppress(OSError):
+    with contextlib.suppress(OSError, UserError):  # the writer's "cannot write" (read-only cache)
         write_map_parquet(road_map, cached)
     return road_map

@@ -22,7 +22,6 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import random
-import shutil
 import traceback
 import warnings
 from collections.abc import Iterator, Mapping
@@ -53,40 +52,33 @@ NO_SNET = {"useCache": False, "writeCache": False}
 def map_params(map_path: Path) -> dict[str, Any]:
     """The global parameters that give Scenic the map: the cached copy, whose ``.snet`` only
     scenegrep writes, or (when the cache cannot be written) the map itself with Scenic's
-    ``.snet`` cache off."""
-    try:
-        return {"map": str(_cached_map(map_path)), "map_options": {"useCache": True, "writeCache": False}}
-    except OSError:
-        return {"map": str(map_path), "map_options": dict(NO_SNET)}
-
-
-def _cached_map(map_path: Path) -> Path:
-    """A copy of the map in the user cache, with the ``.snet`` scenegrep wrote beside it."""
-    from ..readers.opendrive import checked_xodr
-    from ..writers.atomic import atomic_path  # the writers package imports pyarrow and shapely
+    ``.snet`` cache off. A malformed map is a :class:`UserError`."""
+    from ..readers.opendrive import checked_xodr, parse_network
 
     folder = cache_dir() / "scenic-maps" / f"{file_digest(checked_xodr(map_path))[:20]}-scenic{version('scenic')}"
     copy = folder / f"{map_path.stem}.xodr"
-    if not copy.is_file():
-        with atomic_path(copy) as tmp:
-            shutil.copyfile(map_path, tmp)
-    snet = copy.with_suffix(".snet")
-    if not snet.is_file():
-        with atomic_path(snet) as tmp:
-            _write_snet(copy, tmp)
-    return copy
+    if not (copy.is_file() and copy.with_suffix(".snet").is_file()):
+        network = parse_network(map_path)
+        try:
+            _write_cache(map_path, network, copy)
+        except (OSError, UserError):  # the cache cannot be written (the writer's one-line error)
+            return {"map": str(map_path), "map_options": dict(NO_SNET)}
+    return {"map": str(copy), "map_options": {"useCache": True, "writeCache": False}}
 
 
-def _write_snet(xodr: Path, target: Path) -> None:
-    """Scenic's ``.snet`` cache of an ``.xodr`` file (parsed from XML), as ``Network.fromFile``
-    with default map options accepts it: digests of the file and of the (empty) options."""
+def _write_cache(map_path: Path, network: Any, copy: Path) -> None:
+    """Write ``copy`` (the map's bytes) and beside it Scenic's ``.snet`` cache of ``network``
+    (parsed from the map's XML), as ``Network.fromFile`` with default map options accepts it
+    (digests of the file and of the empty options); each written aside and renamed."""
     from scenic.core.serialization import deterministicHash
 
-    from ..readers.opendrive import parse_network
+    from ..writers.atomic import atomic_path  # the writers package imports pyarrow and shapely
 
-    network = parse_network(xodr)
-    digest = hashlib.blake2b(xodr.read_bytes()).digest()
-    network.dumpPickle(target, digest, deterministicHash({}, digest_size=8))
+    data = map_path.read_bytes()
+    with atomic_path(copy) as tmp:
+        tmp.write_bytes(data)
+    with atomic_path(copy.with_suffix(".snet")) as tmp:
+        network.dumpPickle(tmp, hashlib.blake2b(data).digest(), deterministicHash({}, digest_size=8))
 
 
 def compile_program(program: Path, params: Mapping[str, Any]) -> Any:

@@ -13,6 +13,7 @@ import contextlib
 import multiprocessing
 import os
 import signal
+import threading
 from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
@@ -23,6 +24,10 @@ from ..errors import UserError
 
 _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload([__name__])
+_RUNNING: set[int] = set()
+"""Process ids of the query children not yet reaped (each leads its own process group)."""
+_REAPING = threading.Lock()
+"""Held while a child is killed and reaped, so that no group id is killed after its reuse."""
 
 
 class QueryTimeout(Exception):
@@ -37,6 +42,7 @@ def run_limited(root: Path, spec: QuerySpec, jobs: int | None, limit: float) -> 
     receive, send = _CONTEXT.Pipe(duplex=False)
     child = _CONTEXT.Process(target=_child, args=(send, root, spec, jobs), name="scenegrep-serve-query")
     child.start()
+    _RUNNING.add(child.pid)
     send.close()
     try:
         if not receive.poll(limit):
@@ -46,11 +52,21 @@ def run_limited(root: Path, spec: QuerySpec, jobs: int | None, limit: float) -> 
         raise RuntimeError("the query's process ended without an answer") from None
     finally:
         receive.close()
-        _kill_group(child.pid)
-        child.join()
+        with _REAPING:
+            _kill_group(child.pid)
+            child.join()
+            _RUNNING.discard(child.pid)
     if kind == "error":
         raise UserError(value)
     return value
+
+
+def stop_all() -> None:
+    """Kill every running query (children in their own process groups do not get the terminal's
+    Ctrl-C); for a server that stops while a query runs."""
+    with _REAPING:
+        for pid in _RUNNING:
+            _kill_group(pid)
 
 
 def _kill_group(pid: int | None) -> None:

@@ -35,7 +35,7 @@ from ..dataset.results import RESULTS_FILE, Results
 from ..errors import UserError
 from .data import build_view
 from .guard import TIME_LIMIT, TOKEN_HEADER, Refused, check_host, check_post, check_token, dataset_file, public_message
-from .limited import QueryTimeout, run_limited
+from .limited import QueryTimeout, run_limited, stop_all
 from .page import asset, html_page, view_page
 from .report import report_page
 from .sources import ResultsSource, load_trace
@@ -224,3 +224,5 @@ def serve(root: Path, port: int, jobs: int | None, time_limit: float = TIME_LIMI
             server.serve_forever()
         except KeyboardInterrupt:
             print("scenegrep: stopped", file=sys.stderr)
+        finally:
+            stop_all()

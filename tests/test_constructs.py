@@ -6,6 +6,7 @@ Run ``python -m tests.test_constructs`` to rewrite docs/scenic-constructs.md aft
 from __future__ import annotations
 
 import dataclasses
+import importlib
 import inspect
 import math
 import sys
@@ -111,15 +112,9 @@ def _check_rejection(row: dict) -> None:
 def _check_reference(row: dict) -> None:
     """A row proved by another test: that test exists and its source uses the construct."""
     path, name = row["test"].split("::")
-    module = sys.modules.get(path) or _import(path)
+    module = importlib.import_module(path.removesuffix(".py").replace("/", "."))
     function = getattr(module, name)
-    assert row["needle"] in inspect.getsource(function) or row["needle"] in inspect.getsource(module)
-
-
-def _import(path: str):
-    import importlib
-
-    return importlib.import_module(path.removesuffix(".py").replace("/", "."))
+    assert row["needle"] in inspect.getsource(function)
 
 
 def test_local_path_names_a_file_beside_the_program(tmp_path):

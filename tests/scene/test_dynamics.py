@@ -9,6 +9,7 @@ frames computed here from the recording's own ``velocity_x`` / ``velocity_y`` co
 from __future__ import annotations
 
 import dataclasses
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -129,31 +130,30 @@ def test_with_speed_on_a_real_recording(recording):
     assert query.match(trace, None, SceneOptions()).frames().tolist() == expected.tolist()
 
 
-SCENARIO = f"""behavior Drive():
-    while True:
-        wait
-behavior Stop():
-    while True:
-        wait
-behavior Go():
-    do Drive() until self.speed < 1
-    do Stop()
-{ANYWHERE}, with behavior Go()
-require ego.speed > 5
-"""
-
-
 def test_speed_in_a_scenario_guard_and_require_on_a_real_recording(recording):
     """Every frame is labeled Drive and none Stop, so a window matches when the ego's speed exceeds
     5 m/s at its first frame (the require: the initial scene) and stays at or above 1 m/s in every
     frame of it (the guard never ends Drive)."""
+    program = textwrap.dedent(f"""\
+        behavior Drive():
+            while True:
+                wait
+        behavior Stop():
+            while True:
+                wait
+        behavior Go():
+            do Drive() until self.speed < 1
+            do Stop()
+        {ANYWHERE}, with behavior Go()
+        require ego.speed > 5
+        """)
     trace, speed = recording
     labeled = dataclasses.replace(trace, behaviours=BehaviourLabels.from_sets([{"Drive"}] * len(trace.states)))
     window = 15
     starts = range(len(speed) - window + 1)
     expected = [s for s in starts if speed[s] > 5 and (speed[s : s + window] >= 1).all()]
     assert expected == [*range(19), *range(69, 96)]  # 19..23 start fast but reach 0.81 m/s at timestep 33
-    query = compile_scenario(HEADER + SCENARIO, "go.scenic")
+    query = compile_scenario(HEADER + program, "go.scenic")
     result = query.match(labeled, window, None, ScenarioOptions(find_all=True))
     assert [(m.correspondence, m.starts.tolist()) for m in result.matches] == [({"ego": "AV"}, expected)]
 

@@ -234,3 +234,11 @@ def test_without_a_writable_cache_scenic_reads_the_xodr_with_its_snet_cache_off(
     params = map_params(folder / "Town01.xodr")
     assert params == {"map": str(folder / "Town01.xodr"), "map_options": NO_SNET}
     assert NO_SNET == {"useCache": False, "writeCache": False}
+
+
+def test_synth_says_that_scenic_runs_the_programs_python(capsys):
+    with pytest.raises(SystemExit):
+        main(["synth", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "Scenic runs the program's Python code with your rights" in text
+    assert "never a .snet file beside it" in text

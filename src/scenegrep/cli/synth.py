@@ -29,7 +29,7 @@ MANIFEST_FORMAT = "scenegrep-synth-manifest"
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "synth",
-        help="simulate a Scenic program into labeled traces",
+        help="simulate a Scenic program into labeled traces (runs the program's Python: trusted programs only)",
         description="Run a Scenic program (model scenic.simulators.newtonian.driving_model) N times in Scenic's "
         "Newtonian driving simulator and write one scenegrep Parquet trace per run, with positions, headings, "
         "velocities, lanes and the primitive behaviour running at each 0.1 s step, plus DIR/manifest.json. "

@@ -145,6 +145,14 @@ def test_answers_agree_with_a_dense_search(start, size, where, dx, dy):
         assert found
 
 
+def test_without_lanes_the_walk_goes_north():
+    """Off every lane Scenic's road direction is 0 (north): one piece, the end D metres north."""
+    geometry = MapGeometry(RoadMap("empty", ()))
+    pieces = follow_pieces(geometry, FIELD, np.array([3.0]), np.array([4.0]), np.array([5.0]), np.array([35.0]))
+    assert np.allclose(pieces.ax, 0.0) and np.allclose(pieces.ay, 1.0) and np.all(pieces.heading == 0.0)
+    assert pieces.lo.min() == 5.0 and pieces.hi.max() == 35.0
+
+
 def test_a_label_off_the_walk_or_facing_away_does_not_match():
     ex, ey = reference_follow(1.75, 2.0, 30.0)
     assert match(1.75, 2.0, 10.0, 40.0, (ex, ey, end_heading(ex, ey)))[0]

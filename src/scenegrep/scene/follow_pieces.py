@@ -103,7 +103,7 @@ def linework(geometry: MapGeometry) -> Linework:
 def _build_linework(geometry: MapGeometry) -> Linework:
     road_map = geometry._require_map()
     areas = list(road_map.lane_polygons) + [a.polygon for a in road_map.intersections]
-    starts, ends = [], []
+    starts, ends = [np.zeros((0, 2))], [np.zeros((0, 2))]
     for ring in shapely.get_rings(np.array(areas, dtype=object)):
         coords = shapely.get_coordinates(ring)
         starts.append(coords[:-1])

@@ -93,17 +93,25 @@ starts = st.sampled_from(STARTS)
 @settings(max_examples=60, deadline=None, derandomize=True)
 @given(starts, st.floats(0.0, 1.0), st.floats(0.0, 1.0))
 def test_every_walk_ends_on_a_piece(start, where, slack):
-    """Completeness of the pieces: the reference walk for any D ends where a piece holding D says."""
+    """Completeness of the pieces: the reference walk for any D ends where a piece holding D says,
+    also when only the pieces that may end in a box around that end are asked for."""
     (x, y), longest = start
     distance = where * longest
-    pieces = follow_pieces(
-        GEOMETRY, FIELD, np.array([x]), np.array([y]), np.array([distance - 5 * slack]), np.array([distance + 3])
-    )
     ex, ey = reference_follow(x, y, distance)
-    holding = (pieces.lo <= distance) & (distance <= pieces.hi)
-    assert holding.any()
-    errors = np.maximum(np.abs(x + distance * pieces.ax - ex), np.abs(y + distance * pieces.ay - ey))
-    assert errors[holding].min() <= 1e-9
+    for target in (None, np.array([[ex - slack, ex + 0.01, ey - 0.01, ey + slack]])):
+        pieces = follow_pieces(
+            GEOMETRY,
+            FIELD,
+            np.array([x]),
+            np.array([y]),
+            np.array([distance - 5 * slack]),
+            np.array([distance + 3]),
+            target,
+        )
+        holding = (pieces.lo <= distance) & (distance <= pieces.hi)
+        assert holding.any()
+        errors = np.maximum(np.abs(x + distance * pieces.ax - ex), np.abs(y + distance * pieces.ay - ey))
+        assert errors[holding].min() <= 1e-9
 
 
 @settings(max_examples=40, deadline=None, derandomize=True)

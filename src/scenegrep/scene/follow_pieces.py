@@ -281,18 +281,45 @@ class _Branches:
 
 
 def follow_pieces(
-    geometry: MapGeometry, field: Field, x: np.ndarray, y: np.ndarray, lo: np.ndarray, hi: np.ndarray
+    geometry: MapGeometry,
+    field: Field,
+    x: np.ndarray,
+    y: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    target: np.ndarray | None = None,
 ) -> Pieces:
     """The pieces of the walks from (x[i], y[i]) for every D in [lo[i], hi[i]] (metres, finite,
-    lo <= hi, hi <= STEP_M * MAX_STEPS); see the module docstring."""
+    lo <= hi, hi <= STEP_M * MAX_STEPS); see the module docstring. With ``target`` (rows of
+    x_lo, x_hi, y_lo, y_hi per start), only the pieces whose end may lie in that box: a walk
+    whose remaining steps cannot bring it there is dropped as soon as that is certain."""
     lw = linework(geometry)
     b = _by_step_count(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     for k in range(int(b.steps.max(initial=0))):
+        if target is not None:
+            b = b.take(np.flatnonzero(_may_reach(x, y, b, b.steps - k, target)))
         walking = k < b.steps
         moved = _step(geometry, field, lw, x, y, b.take(np.flatnonzero(walking)))
         b = _concat(b.take(np.flatnonzero(~walking)), moved)
+    if target is not None:
+        b = b.take(np.flatnonzero(_may_reach(x, y, b, np.zeros(len(b.row)), target)))
     return _ends(geometry, field, lw, x, y, b)
+
+
+def _may_reach(x, y, b: _Branches, left: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Whether each branch's walk may still end in its start's target box: its current points span
+    a box, and the ``left`` steps move at most ``left * |D| / steps`` metres."""
+    px, qx = x[b.row] + b.lo * b.ax, x[b.row] + b.hi * b.ax
+    py, qy = y[b.row] + b.lo * b.ay, y[b.row] + b.hi * b.ay
+    reach = np.maximum(left, 0) * np.maximum(np.abs(b.lo), np.abs(b.hi)) / b.steps + TIE_M
+    box = target[b.row]
+    return (
+        (np.minimum(px, qx) - reach <= box[:, 1])
+        & (np.maximum(px, qx) + reach >= box[:, 0])
+        & (np.minimum(py, qy) - reach <= box[:, 3])
+        & (np.maximum(py, qy) + reach >= box[:, 2])
+    )
 
 
 def _by_step_count(lo: np.ndarray, hi: np.ndarray) -> _Branches:
@@ -349,7 +376,7 @@ def _merge(branch, low, high, heading):
     new = np.ones(len(branch), dtype=bool)
     new[1:] = (branch[1:] != branch[:-1]) | (heading[1:] != heading[:-1])
     starts = np.flatnonzero(new)
-    ends = np.append(starts[1:], len(branch)) - 1
+    ends = np.append(starts[1:], len(branch))[: len(starts)] - 1
     return branch[starts], low[starts], high[ends], heading[starts]
 
 

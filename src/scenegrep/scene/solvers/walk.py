@@ -84,10 +84,22 @@ def walk_pieces(problems: list[Problem], walks: list[Walk | None], geometry: Map
         return {}
     ranges = np.array([problems[k].ranges[walks[k].distance] for k in rows], dtype=float)  # type: ignore[union-attr]
     starts = np.array([(walks[k].x, walks[k].y) for k in rows], dtype=float)  # type: ignore[union-attr]
-    pieces = follow_pieces(geometry, ROAD_DIRECTION, starts[:, 0], starts[:, 1], ranges[:, 0], ranges[:, 1])
+    target = np.array([_target(problems[k], walks[k]) for k in rows], dtype=float)  # type: ignore[arg-type]
+    pieces = follow_pieces(geometry, ROAD_DIRECTION, starts[:, 0], starts[:, 1], ranges[:, 0], ranges[:, 1], target)
     order = np.argsort(pieces.row, kind="stable")
     bounds = np.searchsorted(pieces.row[order], np.arange(len(rows) + 1))
     return {row: pieces.take(order[bounds[i] : bounds[i + 1]]) for i, row in enumerate(rows)}
+
+
+def _target(problem: Problem, walk: Walk) -> tuple[float, float, float, float]:
+    """The box (x_lo, x_hi, y_lo, y_hi) the walk's end must lie in by the bounds on its coordinates."""
+    box = [-math.inf, math.inf, -math.inf, math.inf]
+    for bound in problem.bounds:
+        if bound.term in walk.ends and not bound.angle:
+            axis = bound.term.value[1]
+            box[2 * axis] = max(box[2 * axis], bound.lo)
+            box[2 * axis + 1] = min(box[2 * axis + 1], bound.hi)
+    return box[0], box[1], box[2], box[3]
 
 
 def solve_walk(

@@ -181,7 +181,7 @@ def test_a_scenic_programs_python_is_never_run(server, tmp_path):
 
 
 def test_a_half_sent_or_negative_length_request_never_blocks_the_page(server, monkeypatch):
-    monkeypatch.setattr(Handler, "timeout", 1.0)
+    monkeypatch.setattr(Handler, "timeout", 3.0)
     stalled = socket.create_connection(("127.0.0.1", server.server_address[1]))
     stalled.sendall(
         f"POST /api/query HTTP/1.1\r\nHost: {server.address}\r\nX-Scenegrep-Token: {server.token}\r\n"
@@ -189,8 +189,8 @@ def test_a_half_sent_or_negative_length_request_never_blocks_the_page(server, mo
     )
     start = time.monotonic()
     assert fetch(server, "api/traces")[0] == 200
-    assert time.monotonic() - start < 1.0
-    stalled.settimeout(5)
+    assert time.monotonic() - start < 2.5  # a server answering one request at a time waits 3 s
+    stalled.settimeout(10)
     assert stalled.recv(100) == b""  # dropped after the read timeout, unanswered
     stalled.close()
     negative = {"Host": server.address, "X-Scenegrep-Token": server.token, "Content-Type": "application/json"}
@@ -211,7 +211,7 @@ def test_a_slow_query_is_stopped_at_the_time_limit_and_blocks_nothing(server):
     slow.join(30)
     ended, (status, body) = answers[0]
     assert status == 408 and json.loads(body)["error"] == "the query ran longer than 1 s and was stopped"
-    assert ended - start < 4.0
+    assert ended - start < 6.0  # the query alone takes over 10 s
     server.time_limit = 300.0
     assert fetch(server, "api/query", SPRE)[0] == 200  # the next query runs
 

@@ -15,7 +15,8 @@ over the vehicles (cars, trucks, buses, trailers, motorcycles) and the ego:
   constant-velocity track gives 0, and braking at 3 m/s² at 10 Hz only 0.015 m);
 * ``heading_jitter`` (rad): the same for the heading of moving vehicles (circular midpoint);
 * ``size_deviation`` (m): the larger of |length - the track's median| and |width - its median|;
-* ``velocity_vs_track`` (m/s): where the data labels velocities, the largest of |vx - vx'|,
+* ``velocity_vs_track`` (m/s): where the data labels velocities (not where a reader estimated
+  them, as for AV2 sensor logs), the largest of |vx - vx'|,
   |vy - vy'| and |speed - speed'| against the track's own finite differences (the primed values).
 
 It prints the median and the 90th, 95th and 99th percentiles of each per dataset, and the
@@ -46,7 +47,7 @@ sys.path.insert(0, str(REPO / "src"))
 from scenegrep import readers  # noqa: E402
 from scenegrep.model import LabelTrace, RoadMap  # noqa: E402
 from scenegrep.model.geometry import heading_difference  # noqa: E402
-from scenegrep.model.kinematics import finite_difference_velocity, track_order  # noqa: E402
+from scenegrep.model.kinematics import ESTIMATED_VELOCITY, finite_difference_velocity, track_order  # noqa: E402
 from scenegrep.model.taxonomy import VEHICLE_KINDS  # noqa: E402
 
 REAL = REPO.parent / "shared" / "real_data"
@@ -130,7 +131,10 @@ def axis_offsets(frame: np.ndarray, lane: np.ndarray, x: np.ndarray, y: np.ndarr
 
 
 def velocity_measures(trace: LabelTrace) -> dict[str, np.ndarray]:
-    """``velocity_vs_track`` of the vehicles whose velocity the data labels."""
+    """``velocity_vs_track`` of the vehicles whose velocity the data labels (none where the reader
+    estimated velocities from the positions)."""
+    if ESTIMATED_VELOCITY in trace.attributes:
+        return {"velocity_vs_track": np.zeros(0)}
     states = trace.states
     vx, vy = finite_difference_velocity(states, trace.frame_time)
     difference = np.fmax(

@@ -19,7 +19,7 @@ from .decide import Tolerance
 
 PROFILES: dict[str, Tolerance] = {
     "exact": Tolerance(),
-    "av2": Tolerance(position=1.3, heading=0.086, speed=0.033),
+    "av2": Tolerance(position=1.3, heading=0.086, speed=1.3),
     "nuscenes": Tolerance(position=1.4, heading=0.084, speed=0.011),
     "waymo": Tolerance(position=0.83, heading=0.049, speed=0.19),
     "commonroad": Tolerance(position=1.2, heading=0.051, speed=0.32),

@@ -204,7 +204,8 @@ def test_a_slow_query_is_stopped_at_the_time_limit_and_blocks_nothing(server):
     slow = threading.Thread(target=lambda: answers.append((time.monotonic(), fetch(server, "api/query", SLOW))))
     start = time.monotonic()
     slow.start()
-    time.sleep(0.3)
+    while not server.query_lock.locked() and time.monotonic() - start < 10:
+        time.sleep(0.01)
     assert fetch(server, "api/traces")[0] == 200
     status, body = fetch(server, "api/query", SPRE)
     assert status == 409 and "another query is running" in json.loads(body)["error"]
@@ -317,3 +318,11 @@ def _descendants(root: int) -> set[str]:
 def _alive(pid: str) -> bool:
     fields = _stat(pid)
     return fields is not None and fields[0] != "Z"
+
+
+@pytest.mark.parametrize("named", ["/etc/hostname.xodr", "../x.snet", "maps"])
+def test_a_programs_param_map_must_name_a_file_inside_the_dataset(server, named):
+    program = f"param map = {named!r}\n{SCENE_PROGRAM}"
+    status, body = fetch(server, "api/query", {"kind": "scene", "text": program, "options": {}})
+    assert status == 400
+    assert json.loads(body)["error"].startswith("option 'param map' must name a file inside the dataset: ")

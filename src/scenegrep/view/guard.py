@@ -77,8 +77,8 @@ def body_length(headers: Message) -> int:
 
 
 def dataset_file(root: Path, value: object, option: str) -> str:
-    """An option naming a file (``vocabulary``): a relative path to a regular file inside the
-    dataset folder at ``root`` (symbolic links resolved), returned as given."""
+    """An option naming a file (``vocabulary``, a program's ``param map``): a relative path to a
+    regular file inside the dataset folder at ``root`` (symbolic links resolved), returned as given."""
     if not isinstance(value, str):
         raise Refused(HTTPStatus.BAD_REQUEST, f"option {option!r} must name a file inside the dataset")
     base = root.resolve()

@@ -18,9 +18,10 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
-from ..dataset.queries import QuerySpec
+from ..dataset.queries import QuerySpec, compiled
 from ..dataset.run import RunOptions, run_query
 from ..errors import UserError
+from .guard import Refused, dataset_file
 
 _CONTEXT = multiprocessing.get_context("forkserver")
 _CONTEXT.set_forkserver_preload([__name__])
@@ -78,15 +79,27 @@ def _kill_group(pid: int | None) -> None:
 
 
 def _child(send: Connection, root: Path, spec: QuerySpec, jobs: int | None) -> None:
-    """Run the query in the dataset folder and send ``("ok", answer)`` or ``("error", line)``."""
+    """Run the query in the dataset folder and send ``("ok", answer)`` or ``("error", line)``;
+    a program's ``param map`` must name a file inside the dataset, as file options do."""
     os.setsid()
     os.chdir(root)
     try:
+        named = _program_map(compiled(spec))
+        if named is not None:
+            dataset_file(root, named, "param map")
         message: tuple[str, Any] = ("ok", answer(run_query(root, spec, RunOptions(jobs=jobs))))
     except UserError as exc:
         message = ("error", exc.one_line())
+    except Refused as exc:
+        message = ("error", exc.reason)
     send.send(message)
     send.close()
+
+
+def _program_map(query: Any) -> str | None:
+    """The file a compiled scene or scenario program's ``param map`` names, if any."""
+    program = getattr(getattr(query, "scene", query), "program", None)
+    return getattr(program, "map_path", None)
 
 
 def answer(results: Any) -> dict[str, Any]:

@@ -380,8 +380,10 @@ class MapGeometry:
 
         Scenic's ``roadDirection`` takes the first intersection containing the point and, there, the
         first of its connecting lanes (in maneuver order) containing it, else the nearest; elsewhere
-        the lane containing the point; outside every lane the nearest lane; outside the road network
-        0. Exact on OpenDRIVE maps, whose intersections keep Scenic's maneuver order.
+        the first lane containing the point; outside every lane 0. Exact on OpenDRIVE maps, whose
+        intersections keep Scenic's maneuver order, except on shoulders and on road area outside
+        every lane, where Scenic takes the element's own centreline direction (the map model holds
+        no shoulder or road centrelines) and this gives 0.
         """
         if not (isinstance(field, MapField) and field.name == "lanes"):
             rows, headings = self.field_values(field, x, y, value)

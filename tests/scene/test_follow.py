@@ -24,6 +24,7 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from scenegrep.errors import UserError
 from scenegrep.model import Area, Lane, RoadMap
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
 from scenegrep.scene.follow_pieces import follow_pieces
@@ -189,6 +190,16 @@ def test_the_follow_operator_is_decided_the_same_way():
     assert on.matched.tolist() == [True] and off.matched.tolist() == [False]
     witness = next(v for k, v in on.values(0).items() if k.startswith("Range"))
     assert abs(witness - 25.0) <= 1e-5
+
+
+@pytest.mark.parametrize("distance", ["Range(10, 1e9)", "Normal(20, 5)", "3e3"])
+def test_a_walk_that_may_exceed_two_kilometres_is_a_user_error(distance):
+    """Scenic would take up to 2e8 Euler steps: refused in one line instead of hanging."""
+    program = f"ego = new Car on road\nc = new Car following roadDirection from ego for {distance}"
+    query = compile_scene(HEADER + program, "follow.scenic")
+    trace = trace_of({"ego": ("Car", 1.75, 2.0, 0.0), "c": ("Car", 1.75, 30.0, 0.0)})
+    with pytest.raises(UserError, match="exceed 2000 m"):
+        query.match(trace, MAP, SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"}))
 
 
 def test_a_requirement_on_the_followed_car_is_decided_on_each_piece():

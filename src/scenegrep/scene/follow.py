@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..errors import UserError
 from .geometry import SMALL_BOX_M
 from .terms import Term
 
@@ -23,12 +24,25 @@ if TYPE_CHECKING:
     from .evaluate import Evaluator
 
 MIN_STEPS = 4
+"""Scenic's minimum number of steps (``VectorField.minSteps``)."""
+
 STEP_M = 5.0
+"""Scenic's default step size (``VectorField.defaultStepSize``), metres."""
+
+MAX_STEPS = 400
+"""The most steps a walk may take (2 km): a longer distance is a user error, not a hang."""
 
 
-def steps_for(distance: np.ndarray) -> np.ndarray:
-    """Scenic's number of Euler steps for each distance."""
-    return np.maximum(MIN_STEPS, np.ceil(np.nan_to_num(distance / STEP_M, nan=0.0))).astype(np.intp)
+def steps_for(distance) -> np.ndarray:
+    """Scenic's number of Euler steps for each distance (metres; NaN takes none); UserError for a
+    distance whose walk would take more than :data:`MAX_STEPS` steps."""
+    scaled = np.nan_to_num(np.asarray(distance, dtype=float) / STEP_M, nan=0.0)
+    if np.any(np.abs(scaled) > MAX_STEPS):
+        raise UserError(
+            f"'follow' or 'following' for a distance that may exceed {STEP_M * MAX_STEPS:g} m"
+            f" ({MAX_STEPS} of Scenic's {STEP_M:g} m steps) is not supported: bound the distance"
+        )
+    return np.maximum(MIN_STEPS, np.ceil(scaled)).astype(np.intp)
 
 
 def follow_field(ev: Evaluator, term: Term) -> np.ndarray:
@@ -51,8 +65,7 @@ def follow_box(geometry, field, x, y, distance, value, covering_arc, intervals):
     have in the current box, so the enclosure holds the walk whichever heading Scenic picks."""
     iv = intervals
     results = []
-    first = int(max(MIN_STEPS, math.ceil(distance.lo / STEP_M)))
-    last = int(max(MIN_STEPS, math.ceil(distance.hi / STEP_M)))
+    first, last = (int(n) for n in steps_for(np.array([distance.lo, distance.hi])))
     for steps in range(first, last + 1):
         step = distance / steps
         px, py = x, y

@@ -39,9 +39,6 @@ from ..model.polylines import Polylines
 from .geometry import MapGeometry
 from .regions import Field
 
-MAX_STEPS = 400
-"""Largest step count enumerated (D up to 2 km); longer walks are left to the other solvers."""
-
 REACH_MARGIN_M = 1.0
 """How far a vertex line reaches beyond the farthest point of its lane from the centreline."""
 

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..follow import STEP_M
-from ..follow_pieces import MAX_STEPS, Pieces, follow_pieces
+from ..follow import MAX_STEPS, STEP_M
+from ..follow_pieces import Pieces, follow_pieces
 from ..geometry import MapGeometry
 from ..regions import MapField
 from ..terms import Term, TermFactory

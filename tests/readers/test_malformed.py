@@ -19,6 +19,7 @@ import pytest
 
 from scenegrep import readers
 from scenegrep.errors import UserError
+from scenegrep.model.trace_arrow import METADATA_KEY
 from scenegrep.readers.scenarionet import RestrictedUnpickler
 from scenegrep.readers.tfrecord import masked_crc32c
 from tests.conftest import REPO
@@ -58,6 +59,24 @@ def test_a_parquet_frame_position_of_2_31_is_refused_before_sizing_arrays(tmp_pa
     start = time.monotonic()
     assert "2147483649 frames: a trace has 0 to 10000000 frames" in _error(path)
     assert time.monotonic() - start < 5
+
+
+@pytest.mark.parametrize(
+    "field, value, message",
+    [
+        ("attributes", 5, "trace attributes must be a mapping, found int"),
+        ("name", ["x"], "trace name, lane ids and source paths must be strings"),
+        ("map_source", [1, "opendrive", None], "trace name, lane ids and source paths must be strings"),
+        ("objects", [[1]], "not enough values to unpack"),
+    ],
+)
+def test_parquet_metadata_of_wrong_types_is_one_line(tmp_path, field, value, message):
+    table = pq.read_table(SAMPLE)
+    meta = json.loads(table.schema.metadata[METADATA_KEY])
+    meta[field] = value
+    path = tmp_path / "meta.parquet"
+    pq.write_table(table.replace_schema_metadata({METADATA_KEY: json.dumps(meta)}), path)
+    assert message in _error(path)
 
 
 @pytest.mark.parametrize("interval", [0, -0.1])

@@ -132,9 +132,19 @@ class LabelTrace:
             raise ValueError("behaviour labels must align with state rows")
         if self.ego is not None and self.ego not in self.objects.row_of():
             raise ValueError(f"ego {self.ego!r} is not an object of the trace")
+        self._validate_fields()
         self._validate_values()
         if self.images is not None:
             self._validate_images(self.images)
+
+    def _validate_fields(self) -> None:
+        """Raise ValueError unless the trace-level fields have their types (a file may give any)."""
+        sources = [f for f in (self.source, self.map_source) if f is not None]
+        texts = [self.name, *self.lane_ids, *(v for f in sources for v in vars(f).values() if v is not None)]
+        if not all(isinstance(t, str) for t in texts):
+            raise ValueError("trace name, lane ids and source paths must be strings")
+        if not isinstance(self.attributes, Mapping):
+            raise ValueError(f"trace attributes must be a mapping, found {type(self.attributes).__name__}")
 
     def _validate_values(self) -> None:
         """Raise ValueError naming the first bad value: known frame times (NaN: unknown) must be

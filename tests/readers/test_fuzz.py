@@ -75,6 +75,7 @@ CASES = [
         ("--no-map",),
         examples=3,
     ),
+    Case("scenegrep-map-parquet", (), "map.parquet", {"map.parquet": PARQUET}, examples=2),
     Case(
         "av2-map",
         (FORECAST / f"log_map_archive_{FORECAST.name}.json",),
@@ -127,9 +128,26 @@ def _write_json_trace(folder: Path) -> None:
     write_trace_json(read_trace(SAMPLE).slice_frames(0, 20), folder / "trace.json")
 
 
-def _prepare(case: Case, folder: Path) -> None:
-    if case.name == "scenegrep-json":
-        _write_json_trace(folder)
+def _write_map_parquet(folder: Path) -> None:
+    """The seed of the scenegrep-map-parquet case: the AV2 forecasting scenario's map."""
+    from scenegrep.readers.av2_map import read_map
+    from scenegrep.writers import write_map_parquet
+
+    write_map_parquet(read_map(FORECAST / f"log_map_archive_{FORECAST.name}.json"), folder / "map.parquet")
+
+
+SEEDS = {"scenegrep-json": _write_json_trace, "scenegrep-map-parquet": _write_map_parquet}
+"""Cases whose seed file is written from a real input rather than copied."""
+
+
+def _prepare(case: Case, folder: Path, seeds: Path) -> None:
+    """Copy the case's inputs into ``folder``; written seeds are made once in ``seeds``."""
+    if case.name in SEEDS:
+        written = seeds / case.name
+        if not written.exists():
+            written.mkdir()
+            SEEDS[case.name](written)
+        shutil.copytree(written, folder, dirs_exist_ok=True)
     for source in case.sources:
         copy = shutil.copytree if source.is_dir() else shutil.copy
         copy(source, folder / source.name)
@@ -188,7 +206,7 @@ def fuzz(case: Case, sandbox: Callable[[list[str]], dict], tmp_path_factory, slo
     def example(seed: int) -> None:
         rng = random.Random(seed)
         folder = tmp_path_factory.mktemp(case.name)
-        _prepare(case, folder)
+        _prepare(case, folder, tmp_path_factory.getbasetemp())
         mutable = rng.choice(sorted(case.mutable))
         m.mutate_file(folder / mutable, case.mutable[mutable], rng)
         target = folder / case.target

@@ -172,3 +172,23 @@ def test_nan_stays_an_unknown_size_and_velocity():
     """NaN means unknown where the data model allows it (z, sizes, velocities): real files use it."""
     trace = readers.read_trace(SAMPLE)
     assert np.isnan(trace.states.z).all()
+
+
+def test_streamed_documents_are_checked_like_files():
+    """``spre --online`` and ``scenario --online`` decode documents from stdin without the
+    file readers' dispatcher: the data model's refusals are one line there too."""
+    from scenegrep.readers.strem_json import iter_documents
+    from scenegrep.readers.trace_json import decode
+
+    frames = [{"index": k, "timestamp": t, "samples": []} for k, t in enumerate([1.0, 0.5])]
+    stream = io.BytesIO(json.dumps({"version": "0.2.0", "frames": frames}).encode() + b"\n")
+    with pytest.raises(UserError, match=r"^<stdin>: not a valid strem-json input: frame 1 \(index 1\): time does not"):
+        list(iter_documents(stream))
+    document = {
+        "scenegrep": "trace",
+        "version": 1,
+        "objects": {"a": {"class": "Car"}},
+        "frames": [{"time": t, "objects": {"a": {"position": [0, 0], "heading": 0}}} for t in (1.0, 0.0)],
+    }
+    with pytest.raises(UserError, match=r"^<stdin>:1: not a valid scenegrep-json input: frame 1 \(index 1\)"):
+        decode(json.dumps(document).encode(), "<stdin>:1", "stdin")

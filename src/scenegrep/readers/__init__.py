@@ -14,7 +14,6 @@ offers some of:
 
 from __future__ import annotations
 
-import contextlib
 import importlib
 from dataclasses import dataclass
 from functools import lru_cache
@@ -24,8 +23,9 @@ from collections.abc import Iterator
 
 from typing import TYPE_CHECKING
 
-from ..errors import UserError, at, first_line
+from ..errors import UserError, at
 from ..model import LabelTrace, MapSource
+from .common import malformed
 from .common import regular_file
 
 if TYPE_CHECKING:
@@ -143,26 +143,6 @@ def _checked(path: str | Path, format_name: str | None, need: str) -> str:
     return name
 
 
-@contextlib.contextmanager
-def _malformed(path: str | Path, format_name: str) -> Iterator[None]:
-    """Turn any failure of a reader on ``path`` into a one-line :class:`UserError` naming it.
-
-    Readers report the mistakes they foresee as user errors with their place; this catches the
-    rest (a value of a wrong type deep in a file, an inconsistency the data model refuses:
-    ``LabelTrace.validate`` raises ValueError naming frame and object), so that a malformed
-    input is never a traceback. Out of memory is reported the same way.
-    """
-    try:
-        yield
-    except UserError:
-        raise
-    except OSError as exc:
-        raise UserError(f"cannot read: {exc.strerror or first_line(exc)}", at(exc.filename or path)) from None
-    except (Exception, RecursionError) as exc:
-        kind = "" if type(exc) is ValueError else f"{type(exc).__name__}: "
-        raise UserError(f"not a valid {format_name} input: {kind}{first_line(exc)}", at(path)) from None
-
-
 def read_traces(path: str | Path, format_name: str | None = None) -> Iterator[LabelTrace]:
     """Every trace in a file or recording directory; a malformed input is a :class:`UserError`
     (a path that is neither a directory, nor ``-`` for stdin, must be a regular file)."""
@@ -170,7 +150,7 @@ def read_traces(path: str | Path, format_name: str | None = None) -> Iterator[La
     if str(path) != "-" and not Path(path).is_dir():
         regular_file(path, f"a trace file ({name})")
     reader = module(name)
-    with _malformed(path, name):
+    with malformed(path, name):
         if hasattr(reader, "read_traces"):
             yield from reader.read_traces(path)
         else:
@@ -191,7 +171,7 @@ def read_trace(path: str | Path, format_name: str | None = None) -> LabelTrace:
 @lru_cache(maxsize=16)
 def _read_map_cached(path: str, format_name: str, key: str | None) -> RoadMap:
     reader = module(format_name)
-    with _malformed(path, format_name):
+    with malformed(path, format_name):
         return reader.read_map(path) if key is None else reader.read_map(path, key)
 
 

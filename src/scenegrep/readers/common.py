@@ -72,3 +72,23 @@ def field(mapping: Mapping[str, Any], key: str, path: str | Path, where: str) ->
         return mapping[key]
     except KeyError:
         raise UserError(f"missing field {key!r} in {where}", at(path)) from None
+
+
+@contextlib.contextmanager
+def malformed(path: str | Path, format_name: str) -> Iterator[None]:
+    """Turn any failure of a reader on ``path`` into a one-line :class:`UserError` naming it.
+
+    Readers report the mistakes they foresee as user errors with their place; this catches the
+    rest (a value of a wrong type deep in a file, an inconsistency the data model refuses:
+    ``LabelTrace.validate`` raises ValueError naming frame and object), so that a malformed
+    input is never a traceback. Out of memory and too deep a recursion are reported the same way.
+    """
+    try:
+        yield
+    except UserError:
+        raise
+    except OSError as exc:
+        raise UserError(f"cannot read: {exc.strerror or first_line(exc)}", at(exc.filename or path)) from None
+    except Exception as exc:
+        kind = "" if type(exc) is ValueError else f"{type(exc).__name__}: "
+        raise UserError(f"not a valid {format_name} input: {kind}{first_line(exc)}", at(path)) from None

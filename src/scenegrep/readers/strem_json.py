@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import UserError, at
 from ..model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
 from . import _strem
-from .common import STDIN, display_name, reading
+from .common import STDIN, display_name, malformed, reading
 from .json_locate import line_column
 from .json_stream import DocumentSplitter
 
@@ -93,7 +93,8 @@ def decode(data: bytes | mmap.mmap, source: str, name: str, release: bool = Fals
                 f"unsupported STREM version {version!r}: expected {STREM_VERSION}",
                 at(source, *line_column(data[:offset], offset), path="version"),
             )
-    return _trace(columns, name, TraceSource(source, FORMAT))
+    with malformed(source, FORMAT):
+        return _trace(columns, name, TraceSource(source, FORMAT))
 
 
 def read_trace(path: str | Path) -> LabelTrace:

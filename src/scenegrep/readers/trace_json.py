@@ -35,7 +35,7 @@ from msgspec import Meta, Struct
 from ..errors import UserError, at
 from ..model import BehaviourLabels, ImageLayer, LabelTrace, MapSource, ObjectTable, StateTable, TraceSource
 from ..model.images import ImageLayerBuilder
-from .common import display_name, read_bytes
+from .common import display_name, malformed, read_bytes
 from .json_locate import msgspec_error
 
 FORMAT = "scenegrep-json"
@@ -174,11 +174,17 @@ def _frame_times(doc: _Trace) -> np.ndarray:
 
 
 def decode(data: bytes, source: str, name: str, base_dir: Path | None = None) -> LabelTrace:
-    """A trace from the bytes of a scenegrep JSON trace document."""
+    """A trace from the bytes of a scenegrep JSON trace document; UserError naming ``source``
+    if it is not one."""
     try:
         doc = _DECODER.decode(data)
     except msgspec.MsgspecError as exc:
         raise msgspec_error(exc, data, 0, source) from None
+    with malformed(source, FORMAT):
+        return _trace(doc, source, name, base_dir)
+
+
+def _trace(doc: _Trace, source: str, name: str, base_dir: Path | None) -> LabelTrace:
     objects = ObjectTable.build(
         list(doc.objects), [o.category for o in doc.objects.values()], [o.attributes for o in doc.objects.values()]
     )

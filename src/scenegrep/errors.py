@@ -56,9 +56,20 @@ def at(
     return SourceLocation(str(source), line, column, path)
 
 
+CARET_WIDTH = 100
+"""The most characters of a source line an error's caret display shows."""
+
+
 def caret(line: str, column: int, width: int = 1) -> str:
-    """A two-line display: the source ``line`` and carets under 1-based columns [column, column + width)."""
+    """A two-line display: the source ``line`` and carets under 1-based columns [column, column + width);
+    a line longer than :data:`CARET_WIDTH` shows only that many characters around the column."""
     width = max(1, min(width, len(line) - column + 1))
+    if len(line) > CARET_WIDTH:
+        start = max(0, min(column - 1 - CARET_WIDTH // 4, len(line) - CARET_WIDTH))
+        shown = line[start : start + CARET_WIDTH]
+        line = ("..." if start else "") + shown + ("..." if start + CARET_WIDTH < len(line) else "")
+        column = column - start + (3 if start else 0)
+        width = max(1, min(width, CARET_WIDTH - (column - 1)))
     return f"  {line}\n  {' ' * (column - 1)}{'^' * width}"
 
 

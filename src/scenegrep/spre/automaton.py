@@ -26,12 +26,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import syntax as s
+from .tokens import MAX_POSITIONS
 
 ANY = -1
 """The letter of ``.`` positions: satisfied by every frame."""
 
 MAX_CACHED_STATES = 10_000
 """DFA states kept before the transition cache is cleared (as RE2 does when it fills)."""
+
+MAX_EDGES = 4_000_000
+"""Most follow-list entries an automaton may have (Glushkov automata can be quadratic in their
+positions: ``([[:car:]]?){0,5000}``); about 32 MB."""
+
+
+class TooLarge(Exception):
+    """The automaton would have more than :data:`MAX_POSITIONS` positions (repetitions expanded,
+    track binders instantiated per object) or :data:`MAX_EDGES` transitions."""
+
 
 LetterKey = tuple[s.Formula, tuple[tuple[str, int], ...]]
 """A distinct letter: a formula and the track bindings it is evaluated under."""
@@ -68,13 +79,19 @@ class _Builder:
         self.letters: dict[LetterKey, int] = {}
         self.position_letter: list[int] = []
         self.follow: list[list[int]] = []
+        self.edges = 0
 
     def position(self, letter: int) -> int:
+        if len(self.position_letter) >= MAX_POSITIONS:
+            raise TooLarge(f"the query expands to more than {MAX_POSITIONS} frame letters")
         self.position_letter.append(letter)
         self.follow.append([])
         return len(self.position_letter) - 1
 
     def link(self, lasts: Sequence[int], firsts: Sequence[int]) -> None:
+        self.edges += len(lasts) * len(firsts)
+        if self.edges > MAX_EDGES:
+            raise TooLarge(f"the query's automaton has more than {MAX_EDGES} transitions")
         for p in lasts:
             self.follow[p].extend(firsts)
 
@@ -132,9 +149,14 @@ class _Builder:
         return self.concat(parts) if parts else ([], [], True)
 
     def optional_chain(self, fresh, count: int) -> tuple[list[int], list[int], bool]:
-        """``(X (X (...)?)?)?`` with ``count`` copies of X."""
-        first, last, _ = self.concat([fresh] + ([lambda: self.optional_chain(fresh, count - 1)] if count > 1 else []))
-        return first, last, True
+        """``(X (X (...)?)?)?`` with ``count`` copies of X, built from the innermost copy out
+        (no recursion, so ``{0,500}`` is as cheap as ``{500}``)."""
+        copies = [fresh() for _ in range(count)]
+        first: list[int] = []
+        for c_first, c_last, c_nullable in reversed(copies):
+            self.link(c_last, first)
+            first = c_first + first if c_nullable else c_first
+        return first, [p for _, c_last, _ in copies for p in c_last], True
 
 
 def compile_automaton(query: s.Query, candidates: dict[s.Binding, Sequence[int]] | None = None) -> Automaton:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from ..errors import UserError
 from . import syntax as s
 from .errors import query_error
+from .tokens import MAX_NESTING, MAX_NODES, MAX_POSITIONS, TOO_DEEP
 
 FUNCTIONS: dict[str, tuple[int, ...]] = {
     "x": (1,),
@@ -35,8 +36,6 @@ STREM_FUNCTIONS: dict[str, tuple[int, ...]] = {"x": (1,), "y": (1,), "area": (1,
 """The functions STREM v0.2.0 evaluates (any other name or arity makes it panic)."""
 
 STREM_MAX_LETTERS = 52
-MAX_POSITIONS = 200_000
-"""Largest automaton (letter occurrences after expanding repetitions) a query may compile to."""
 
 
 @dataclass(frozen=True)
@@ -113,9 +112,29 @@ def _written_letters(query: s.Query) -> int:
     return sum(_written_letters(c) for c in _sub_queries(query))
 
 
+def _too_big(query: s.Query) -> tuple[s.Node, str] | None:
+    """The first node nested more than :data:`MAX_NESTING` levels below the root (chains of
+    ``+ - * /`` nest one level per operator), or the node past :data:`MAX_NODES`, with the
+    message; found without recursion."""
+    stack: list[tuple[s.Node, int]] = [(query, 1)]
+    seen = 0
+    while stack:
+        node, depth = stack.pop()
+        seen += 1
+        if depth > MAX_NESTING:
+            return node, TOO_DEEP
+        if seen > MAX_NODES:
+            return node, f"the query has more than {MAX_NODES} terms and operators"
+        stack.extend((child, depth + 1) for child in node.children())
+    return None
+
+
 def check(query: s.Query, text: str, source: str = "<query>", compat: bool = False) -> Checked:
     """Check a parsed query; returns it with any warnings, or raises a :class:`UserError`."""
     checker = _Checker(text, source, compat)
+    too_big = _too_big(query)
+    if too_big is not None:
+        raise checker.fail(too_big[1], too_big[0])
     checker.walk(query, frozenset())
     if _letters(query) > MAX_POSITIONS:
         raise query_error(

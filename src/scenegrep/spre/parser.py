@@ -32,12 +32,12 @@ complement. The body of a quantifier is the formula right after it (parenthesise
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from ..errors import UserError
 from . import syntax as s
 from .errors import query_error
-from .tokens import Cursor, Token, tokenize, unquote
+from .tokens import Cursor, Token, TooDeep, nested, tokenize, unquote
 
 T = TypeVar("T")
 
@@ -65,6 +65,8 @@ class Parser(Cursor):
         saved = self.pos
         try:
             return parse()
+        except TooDeep:
+            raise
         except (UserError, _Backtrack):
             self.pos = saved
             return None
@@ -111,11 +113,11 @@ class Parser(Cursor):
         return item
 
     def bounds(self, brace: Token) -> tuple[int, int | None]:
-        low = int(self.take().text) if self.at("INT") else None
+        low = self.count() if self.at("INT") else None
         high: int | None
         if self.at(","):
             self.take()
-            high = int(self.take().text) if self.at("INT") else None
+            high = self.count() if self.at("INT") else None
         else:
             high = low
         close = self.expect("}", "'}' closing the repetition")
@@ -134,6 +136,7 @@ class Parser(Cursor):
             )
         return low, high
 
+    @nested
     def primary(self) -> s.Query:
         start = self.token
         if self.at("."):
@@ -162,21 +165,22 @@ class Parser(Cursor):
 
     # ------------------------------------------------------------------ formulas
     def formula(self) -> s.Formula:
-        start = self.token
-        left = self.conjunction()
-        while self.at("|"):
-            self.take()
-            left = s.Or(left, self.conjunction(), self.span(start))
-        return left
+        return self.chain("|", s.Or, self.conjunction)
 
     def conjunction(self) -> s.Formula:
-        start = self.token
-        left = self.unary()
-        while self.at("&"):
-            self.take()
-            left = s.And(left, self.unary(), self.span(start))
-        return left
+        return self.chain("&", s.And, self.unary)
 
+    def chain(self, op: str, node: type, operand: Callable[[], T]) -> T:
+        """Operands separated by the associative operator ``op``, joined by ``node`` as a balanced
+        tree: a chain of thousands of operands nests only log2 of their number deep."""
+        start = self.token
+        items = [operand()]
+        while self.at(op):
+            self.take()
+            items.append(operand())
+        return _balanced(node, items, self.span(start))
+
+    @nested
     def unary(self) -> s.Formula:
         start = self.token
         if self.at("!", "~"):
@@ -272,6 +276,7 @@ class Parser(Cursor):
             left = s.Arithmetic(op, left, self.signed(), self.span(start))
         return left
 
+    @nested
     def signed(self) -> s.Metric:
         start = self.token
         if self.at("-"):
@@ -309,21 +314,12 @@ class Parser(Cursor):
 
     # ------------------------------------------------------------------ terms
     def term(self) -> s.Term:
-        start = self.token
-        left = self.term_intersection()
-        while self.at("|"):
-            self.take()
-            left = s.Union(left, self.term_intersection(), self.span(start))
-        return left
+        return self.chain("|", s.Union, self.term_intersection)
 
     def term_intersection(self) -> s.Term:
-        start = self.token
-        left = self.term_unary()
-        while self.at("&"):
-            self.take()
-            left = s.Intersection(left, self.term_unary(), self.span(start))
-        return left
+        return self.chain("&", s.Intersection, self.term_unary)
 
+    @nested
     def term_unary(self) -> s.Term:
         start = self.token
         if self.at("!", "~"):
@@ -391,6 +387,17 @@ class Parser(Cursor):
         else:
             value = self.expect("IDENT", "a filter value").text
         return s.Filter(key, op, value)
+
+
+def _balanced(node: type, items: list, span: s.Span) -> Any:
+    """``items`` joined pairwise by ``node`` into a balanced tree spanning ``span`` (left-deep for
+    up to three items)."""
+    if len(items) == 1:
+        return items[0]
+    half = (len(items) + 1) // 2
+    left = _balanced(node, items[:half], (items[0].span[0], items[half - 1].span[1]))
+    right = _balanced(node, items[half:], (items[half].span[0], items[-1].span[1]))
+    return node(left, right, span)
 
 
 def _is_metric(node: object) -> bool:

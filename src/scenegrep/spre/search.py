@@ -21,12 +21,21 @@ import numpy as np
 from ..errors import UserError
 from ..model import LabelTrace
 from . import syntax as s
-from .automaton import Automaton, ForwardScan, compile_automaton, leftmost_longest, longest_from_each_start
+from .automaton import (
+    Automaton,
+    ForwardScan,
+    TooLarge,
+    compile_automaton,
+    leftmost_longest,
+    longest_from_each_start,
+)
 from .checks import check, check_strem_online
+from .errors import query_error
 from .evaluate import Evaluator
 from .parser import parse
 from .space import Space, image_space, topdown_space
 from .strem_parser import parse_strem
+from .tokens import MAX_CHARACTERS
 
 
 @dataclass(frozen=True)
@@ -45,12 +54,25 @@ class CompiledQuery:
 
 def compile_query(text: str, compat: bool = False, source: str = "<query>") -> CompiledQuery:
     """Parse and check a query (scenegrep's syntax, or STREM's with ``compat``); UserError on any problem."""
+    if len(text) > MAX_CHARACTERS:
+        raise query_error(
+            f"the query is longer than {MAX_CHARACTERS} characters", text, MAX_CHARACTERS, len(text), source
+        )
     if compat:
         tree, warnings = parse_strem(text, source)
     else:
         tree, warnings = parse(text, source), []
     checked = check(tree, text, source, compat)
     return CompiledQuery(text, tree, compat, tuple(warnings) + checked.warnings)
+
+
+def automaton_of(query: CompiledQuery, candidates: dict[s.Binding, list[int]] | None = None) -> Automaton:
+    """The query's automaton (track binders over ``candidates``); a :class:`UserError` at the query
+    when it is over the automaton's size limits."""
+    try:
+        return compile_automaton(query.tree, candidates)
+    except TooLarge as exc:
+        raise query_error(f"{exc}; use smaller repetitions", query.text, 0, max(len(query.text), 1)) from None
 
 
 @dataclass(frozen=True)
@@ -128,7 +150,7 @@ class TraceSearch:
         self.trace = trace
         self.evaluator = Evaluator(build_space(trace, options, query.compat), strem=query.compat)
         self.candidates = _candidates(query, self.evaluator)
-        self.automaton = compile_automaton(query.tree, self.candidates)
+        self.automaton = automaton_of(query, self.candidates)
         self.masks = letter_masks(self.automaton, self.evaluator)
 
     def matches(self, spans: Iterable[tuple[int, int]]) -> Iterator[Match]:
@@ -144,7 +166,7 @@ class TraceSearch:
         for binding, objects in self.candidates.items():
             for obj in objects:
                 only = {**self.candidates, binding: [obj]}
-                automaton = compile_automaton(self.query.tree, only)
+                automaton = automaton_of(self.query, only)
                 masks = letter_masks(automaton, self.evaluator)[start:end]
                 ends = longest_from_each_start(automaton, masks)
                 if len(ends) and ends[0] == end - start:
@@ -183,7 +205,7 @@ def search_stream(
         raise UserError("track binders E(...)(...) need the whole trace; they cannot run on a live stream")
     if query.compat:
         check_strem_online(query.tree, query.text)
-    automaton = compile_automaton(query.tree)
+    automaton = automaton_of(query)
     scan = ForwardScan(automaton)
     skip = options.skip
     position = 0

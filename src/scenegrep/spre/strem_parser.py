@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from . import syntax as s
 from .errors import query_error
-from .tokens import Cursor, Token, tokenize_strem
+from .tokens import Cursor, Token, nested, tokenize_strem
 
 
 class StremParser(Cursor):
@@ -44,6 +44,7 @@ class StremParser(Cursor):
             raise self.error(f"syntax error: unexpected {self.token.text!r}")
         return query
 
+    @nested
     def spre(self) -> s.Query:
         start = self.token
         item = self.prim()
@@ -60,11 +61,11 @@ class StremParser(Cursor):
         brace = self.take()
         if brace.kind == "*":
             return s.Repeat(item, 0, None, self.span(start))
-        low = int(self.expect("INT", "an integer").text)
+        low = self.count("an integer")
         high: int | None = low
         if self.at(","):
             self.take()
-            high = int(self.take().text) if self.at("INT") else None
+            high = self.count() if self.at("INT") else None
         close = self.expect("}", "'}'")
         if high is not None and low > high:
             raise query_error(
@@ -89,6 +90,7 @@ class StremParser(Cursor):
         return s.Letter(formula, self.span(start))
 
     # ------------------------------------------------------------------ spatial formulas
+    @nested
     def s4u(self) -> s.Formula:
         start = self.token
         head = self.s4u_head()
@@ -134,6 +136,7 @@ class StremParser(Cursor):
             return s.Compare(op, left, self.s4m(), self.span(start))
         raise self.error("syntax error")
 
+    @nested
     def binds(self) -> tuple[s.Binding, ...]:
         start = self.token
         name = self.expect("IDENT", "a variable").text
@@ -145,6 +148,7 @@ class StremParser(Cursor):
         return (binding,)
 
     # ------------------------------------------------------------------ metric expressions
+    @nested
     def s4m(self) -> s.Metric:
         start = self.token
         head = self.s4m_head()
@@ -178,6 +182,7 @@ class StremParser(Cursor):
         raise self.error("syntax error")
 
     # ------------------------------------------------------------------ spatial terms
+    @nested
     def s4(self) -> s.Term:
         start = self.token
         head = self.s4_head()

@@ -63,10 +63,12 @@ class Node:
                     yield item
 
     def walk(self) -> Iterator[Node]:
-        """This node and every node inside it, depth first."""
-        yield self
-        for child in self.children():
-            yield from child.walk()
+        """This node and every node inside it, depth first (without recursion)."""
+        stack: list[Node] = [self]
+        while stack:
+            node = stack.pop()
+            yield node
+            stack.extend(reversed(list(node.children())))
 
 
 _MISSING = object()

@@ -12,12 +12,17 @@ the rest:
 
 from __future__ import annotations
 
+import functools
 import json
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any, TypeVar
 
 from ..errors import UserError
 from .errors import query_error
+
+T = TypeVar("T")
 
 ANGLE_KEYWORDS = frozenset(
     {
@@ -142,11 +147,52 @@ def tokenize_strem(text: str, source: str = "<query>") -> tuple[list[Token], lis
     return tokens, warnings
 
 
+MAX_NESTING = 100
+"""The deepest a query may nest: groups, prefix operators, quantifiers, track binders (and, in
+STREM's right-associative grammar, chained operators)."""
+
+MAX_POSITIONS = 20_000
+"""Largest automaton (letter occurrences after expanding repetitions) a query may compile to; also
+the largest repetition count. A frame costs up to this many position steps."""
+
+MAX_CHARACTERS = 100_000
+"""Longest query text (parsing costs about 10 µs per character)."""
+
+MAX_NODES = 10_000
+"""Most syntax nodes (letters, operators, terms, numbers) a query may have."""
+
+TOO_DEEP = f"the query nests more than {MAX_NESTING} levels deep (groups, operators, quantifiers)"
+
+
+class TooDeep(UserError):
+    """A query nested beyond :data:`MAX_NESTING`; never backtracked over."""
+
+
+def nested(parse: Callable[..., T]) -> Callable[..., T]:
+    """Decorates a parser method through which the grammar recurses: more than :data:`MAX_NESTING`
+    of them active at once is a :class:`TooDeep` error at the current token (before Python's stack
+    runs out)."""
+
+    @functools.wraps(parse)
+    def guarded(self: Cursor, *args: Any) -> T:
+        if self.depth >= MAX_NESTING:
+            error = self.error(TOO_DEEP)
+            raise TooDeep(error.message, error.location, error.detail)
+        self.depth += 1
+        try:
+            return parse(self, *args)
+        finally:
+            self.depth -= 1
+
+    return guarded
+
+
 class Cursor:
     """A position in a token list, with the helpers both parsers use."""
 
     def __init__(self, text: str, source: str, tokens: list[Token]):
         self.text, self.source, self.tokens, self.pos = text, source, tokens, 0
+        self.depth = 0
 
     @property
     def token(self) -> Token:
@@ -170,6 +216,13 @@ class Cursor:
             found = "the end of the query" if self.at("END") else repr(self.token.text)
             raise self.error(f"expected {what} but found {found}")
         return self.take()
+
+    def count(self, what: str = "a repetition count") -> int:
+        """A repetition count (an INT token, ``what`` in the error if absent), at most :data:`MAX_POSITIONS`."""
+        token = self.expect("INT", what)
+        if len(token.text) > len(str(MAX_POSITIONS)) or int(token.text) > MAX_POSITIONS:
+            raise self.error(f"repetition count {token.text[:12]} is above the limit of {MAX_POSITIONS}", token)
+        return int(token.text)
 
     def span(self, start: Token) -> tuple[int, int]:
         """From the start of ``start`` to the end of the last token taken."""

@@ -1,0 +1,122 @@
+"""Everything a SpRE can make huge is bounded before work starts (README "Limits"): nesting, the
+number of terms, the text's length, repetition counts and the automaton's size are each a one-line
+error at line:column with exit code 2, fast; queries within the limits answer, whatever their
+shape, without recursion errors.
+
+* explicit huge queries through the command line (``main([...])`` in process): exit 2, the error
+  line names the place and the limit, only the caret display follows (clipped to a short line), no
+  traceback, under a few seconds;
+* queries just inside the nesting limit, in every construct that nests, and ``{0,500}`` answer;
+* ``X{0,k}`` compiles to exactly the automaton of its nested spelling ``(X(X(...)?)?)?`` (the
+  construction is now iterative; this is the recursive one it replaced), for nullable X too.
+"""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from scenegrep.cli.main import main
+from scenegrep.spre.automaton import MAX_EDGES, compile_automaton
+from scenegrep.spre.parser import parse
+from scenegrep.spre.tokens import MAX_CHARACTERS, MAX_NESTING, MAX_NODES, MAX_POSITIONS
+
+TRACE = "examples/sample/fig1_lane_change-000.parquet"
+DEEP = 10_000
+WIDE = 50_000
+NESTS = f"nests more than {MAX_NESTING} levels deep"
+
+HUGE = {
+    "groups": ("(" * DEEP + "[[:car:]]" + ")" * DEEP, NESTS),
+    "formula groups": ("[" + "(" * DEEP + "[:car:]" + ")" * DEEP + "]", NESTS),
+    "negations": ("[" + "!" * DEEP + "[:car:]]", NESTS),
+    "complements": ("[NE " + "~" * DEEP + "[:car:]]", NESTS),
+    "quantifiers": ("[" + "E(x := [:car:]) " * 5_000 + "x]", NESTS),
+    "track binders": ("E(x := [:car:])" * 5_000 + "[x]", NESTS),
+    "minus signs": ("[@area([:car:]) > " + "-" * DEEP + "1]", NESTS),
+    "metric groups": ("[@area([:car:]) > " + "(" * DEEP + "1" + ")" * DEEP + "]", NESTS),
+    "a sum chain": ("[" + "+".join(["1"] * 5_000) + " > 0]", NESTS),
+    "nested repeats": ("(" * DEEP + "[[:car:]]" + "){2}" * DEEP, NESTS),
+    "alternatives": ("|".join(["[[:car:]]"] * 5_000), f"more than {MAX_NODES} terms"),
+    "disjuncts": ("[" + " | ".join(["[:car:]"] * 5_000) + "]", f"more than {MAX_NODES} terms"),
+    "a concatenation": ("[[:car:]]" * 5_000 + "[[:bus:]]" * 5_000, f"more than {MAX_NODES} terms"),
+    "50,000 terms": ("|".join(["[[:car:]]"] * WIDE), f"longer than {MAX_CHARACTERS} characters"),
+    "a huge count": ("[[:car:]]{0,100000000000}", f"above the limit of {MAX_POSITIONS}"),
+    "a 5,000-digit count": ("[[:car:]]{" + "9" * 5_000 + "}", f"above the limit of {MAX_POSITIONS}"),
+    "repeats of repeats": ("(([[:car:]]{200}){200})", f"more than {MAX_POSITIONS} frame letters"),
+    "track binders over every car": ("E(x := [:car:])" * 15 + "[x]", f"more than {MAX_POSITIONS} frame letters"),
+    "a quadratic automaton": ("([[:car:]]?){0,5000}", f"more than {MAX_EDGES} transitions"),
+}
+
+STREM = {
+    "groups": ("(" * DEEP + "[[:car:]]" + ")" * DEEP, NESTS),
+    "a concatenation": ("[[:car:]]" * 5_000, NESTS),
+    "a conjunction": ("[" + "&".join(["[:car:]"] * 5_000) + "]", NESTS),
+    "negations": ("[" + "!" * DEEP + "[:car:]]", NESTS),
+}
+
+
+def _run(args: list[str], capsys) -> tuple[int, list[str], float]:
+    began = time.perf_counter()
+    code = main(args)
+    elapsed = time.perf_counter() - began
+    return code, capsys.readouterr().err.splitlines(), elapsed
+
+
+def _assert_one_line_error(code: int, lines: list[str], elapsed: float, message: str) -> None:
+    assert code == 2
+    assert lines[0].startswith("scenegrep: error: <query>:1:") and message in lines[0], lines[0][:300]
+    assert len(lines) == 3 and all(len(line) < 120 for line in lines[1:]), "only a short caret display follows"
+    assert "Traceback" not in "\n".join(lines)
+    assert elapsed < 5, f"{elapsed:.1f} s"
+
+
+@pytest.mark.parametrize("name", HUGE)
+def test_a_huge_query_is_a_one_line_error(name, capsys):
+    query, message = HUGE[name]
+    _assert_one_line_error(*_run(["spre", "--space", "topdown", query, TRACE], capsys), message)
+
+
+@pytest.mark.parametrize("name", STREM)
+def test_a_huge_strem_query_is_a_one_line_error(name, capsys):
+    query, message = STREM[name]
+    _assert_one_line_error(*_run(["spre", "--compat", "strem", query, "-"], capsys), message)
+
+
+INSIDE = MAX_NESTING - 6
+WITHIN = {
+    "groups": "(" * INSIDE + "[[:car:]]" + ")" * INSIDE,
+    "formula groups": "[" + "(" * INSIDE + "[:car:]" + ")" * INSIDE + "]",
+    "negations": "[" + "!" * (INSIDE - 1) + "[:car:]]",
+    "complements": "[NE " + "~" * INSIDE + "[:car:]]",
+    "minus signs": "[@area([:car:]) > " + "-" * INSIDE + "1]",
+    "nested concatenations": "([[:car:]]" * INSIDE + ")" * INSIDE,
+    "nested repeats": "(" * INSIDE + "[[:car:]]" + "){1}" * INSIDE,
+    "{0,500}": "[[:car:]]{0,500}",
+    "a wide formula": "[" + " | ".join(["[:car:]"] * 3_000) + "]",
+}
+
+
+@pytest.mark.parametrize("name", WITHIN)
+def test_a_query_within_the_limits_answers(name, capsys):
+    code, lines, elapsed = _run(["spre", "--space", "topdown", "-q", WITHIN[name], TRACE], capsys)
+    assert code in (0, 1), lines[:1]
+    assert elapsed < 10
+
+
+ITEMS = ["[[:car:]]", "[[:car:]]?", "[[:car:]]*", "([[:car:]][[:bus:]]?)", ".", "([[:car:]]|[[:bus:]]*)"]
+
+
+def _nested(item: str, count: int) -> str:
+    return "" if count == 0 else f"({item}{_nested(item, count - 1)})?"
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(ITEMS), st.integers(0, 3), st.integers(1, 6))
+def test_a_bounded_repeat_compiles_as_its_nested_spelling(item, low, extra):
+    counted = compile_automaton(parse(f"{item}{{{low},{low + extra}}}"))
+    spelled = compile_automaton(parse("".join([item] * low) + _nested(item, extra)))
+    assert counted == spelled

@@ -23,12 +23,19 @@ from ..dataset.run import RunOptions, run_query
 from ..errors import UserError
 from .guard import Refused, dataset_file
 
+PRELOAD = (__name__, "pyarrow.dataset", "scenegrep.spre", "scenegrep.scene", "scenegrep.scenario", "scenegrep.label")
+"""Modules the fork server imports once, so that a query's child starts with them (a cold
+``pyarrow.dataset``, the first Parquet read, alone takes 1.5 s)."""
 _CONTEXT = multiprocessing.get_context("forkserver")
-_CONTEXT.set_forkserver_preload([__name__])
+_CONTEXT.set_forkserver_preload(list(PRELOAD))
 _RUNNING: set[int] = set()
 """Process ids of the query children not yet reaped (each leads its own process group)."""
 _REAPING = threading.Lock()
 """Held while a child is killed and reaped, so that no group id is killed after its reuse."""
+
+
+EXIT_GRACE = 5.0
+"""Seconds a child that answered (or died) may take to exit before its group is killed."""
 
 
 class QueryTimeout(Exception):
@@ -45,21 +52,36 @@ def run_limited(root: Path, spec: QuerySpec, jobs: int | None, limit: float) -> 
     child.start()
     _RUNNING.add(child.pid)
     send.close()
+    grace = 0.0
     try:
         if not receive.poll(limit):
             raise QueryTimeout(f"the query ran longer than {limit:g} s and was stopped")
+        grace = EXIT_GRACE
         kind, value = receive.recv()
     except EOFError:
         raise RuntimeError("the query's process ended without an answer") from None
     finally:
         receive.close()
-        with _REAPING:
-            _kill_group(child.pid)
-            child.join()
-            _RUNNING.discard(child.pid)
+        _reap(child, grace)
     if kind == "error":
         raise UserError(value)
     return value
+
+
+def _reap(child: Any, grace: float) -> None:
+    """Let the child exit within ``grace`` seconds, then kill what is left of its group."""
+    with _REAPING:
+        child.join(grace)
+        _kill_group(child.pid)
+        child.join()
+        _RUNNING.discard(child.pid)
+
+
+def start_fork_server() -> None:
+    """Start the fork server (importing :data:`PRELOAD`) now rather than at the first query."""
+    from multiprocessing import forkserver
+
+    forkserver.ensure_running()
 
 
 def stop_all() -> None:
@@ -71,8 +93,9 @@ def stop_all() -> None:
 
 
 def _kill_group(pid: int | None) -> None:
-    """Kill the child's process group (the child, and the workers it forked); the child is not
-    yet reaped, so its group id cannot have been reused."""
+    """Kill the child's process group (the child, and the workers it forked). While any member
+    lives the group id cannot be reused; once none does, nothing has that group id but a
+    process that has since made itself a group leader with the same id (not guarded against)."""
     if pid is not None:
         with contextlib.suppress(ProcessLookupError, PermissionError):
             os.killpg(pid, signal.SIGKILL)

@@ -35,7 +35,7 @@ from ..dataset.results import RESULTS_FILE, Results
 from ..errors import UserError
 from .data import build_view
 from .guard import TIME_LIMIT, TOKEN_HEADER, Refused, check_host, check_post, check_token, dataset_file, public_message
-from .limited import QueryTimeout, run_limited, stop_all
+from .limited import QueryTimeout, run_limited, start_fork_server, stop_all
 from .page import asset, html_page, view_page
 from .report import report_page
 from .sources import ResultsSource, load_trace
@@ -60,6 +60,7 @@ class DatasetServer(ThreadingHTTPServer):
         self.token = secrets.token_urlsafe(32)
         self.query_lock = threading.Lock()
         super().__init__((HOST, port), Handler)
+        start_fork_server()
 
     @property
     def address(self) -> str:

@@ -192,6 +192,22 @@ def test_the_follow_operator_is_decided_the_same_way():
     assert abs(witness - 25.0) <= 1e-5
 
 
+def test_a_distance_bounded_by_another_random_variable():
+    """``Range(d, 20)`` with ``d`` random: D's range comes from d's, and the pieces are exact."""
+    program = "ego = new Car on road\nd = Range(8, 12)\nc = new Car following roadDirection from ego for Range(d, 20)"
+    query = compile_scene(HEADER + program, "follow.scenic")
+    options = SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"})
+    for distance, expected in ((9.0, True), (15.0, True), (7.0, False), (21.0, False)):
+        ex, ey = reference_follow(1.75, 2.0, distance)
+        trace = trace_of({"ego": ("Car", 1.75, 2.0, 0.0), "c": ("Car", ex, ey, end_heading(ex, ey))})
+        result = query.match(trace, MAP, options)
+        assert result.matched.tolist() == [expected], distance
+        if expected:
+            values = result.values(0)
+            d, walked = values["Range(8, 12)@3:5"], values["Range(d, 20)@4:50"]
+            assert 8 <= d <= walked <= 20 and abs(walked - distance) <= 1e-5
+
+
 @pytest.mark.parametrize("distance", ["Range(10, 1e9)", "Normal(20, 5)", "3e3"])
 def test_a_walk_that_may_exceed_two_kilometres_is_a_user_error(distance):
     """Scenic would take up to 2e8 Euler steps: refused in one line instead of hanging."""

@@ -34,10 +34,11 @@ MAX_STEPS = 400
 
 
 def steps_for(distance) -> np.ndarray:
-    """Scenic's number of Euler steps for each distance (metres; NaN takes none); UserError for a
-    distance whose walk would take more than :data:`MAX_STEPS` steps."""
+    """Scenic's number of Euler steps for each distance (metres; NaN takes none, a negative
+    distance walks back in the minimum); UserError for a distance whose walk would take more than
+    :data:`MAX_STEPS` steps."""
     scaled = np.nan_to_num(np.asarray(distance, dtype=float) / STEP_M, nan=0.0)
-    if np.any(np.abs(scaled) > MAX_STEPS):
+    if np.any(scaled > MAX_STEPS):
         raise UserError(
             f"'follow' or 'following' for a distance that may exceed {STEP_M * MAX_STEPS:g} m"
             f" ({MAX_STEPS} of Scenic's {STEP_M:g} m steps) is not supported: bound the distance"

@@ -26,7 +26,8 @@ from ..follow_pieces import Pieces, follow_pieces
 from ..geometry import MapGeometry
 from ..regions import MapField
 from ..terms import Term, TermFactory
-from .branch_prune import Outcome
+from .branch_prune import BoxEvaluator, Outcome
+from .intervals import Interval
 from .problem import Bound, Problem
 
 ROAD_DIRECTION = MapField("lanes")
@@ -45,6 +46,8 @@ class Walk:
     y: float
     distance: Term
     ends: tuple[Term, ...]
+    lo: float
+    hi: float
 
 
 def find_walk(problem: Problem) -> Walk | None:
@@ -56,10 +59,34 @@ def find_walk(problem: Problem) -> Walk | None:
     same = all(t.args == found[0].args and t.value[0] == ROAD_DIRECTION for t in found)
     if not same or not (x.is_const and y.is_const) or distance not in problem.scalars or problem.points:
         return None
-    lo, hi = problem.ranges[distance]
+    lo, hi = _distance_range(problem, distance)
     if not (math.isfinite(lo) and math.isfinite(hi)) or hi < lo or max(abs(lo), abs(hi)) > STEP_M * MAX_STEPS:
         return None
-    return Walk(float(x.value), float(y.value), distance, tuple(sorted(found, key=lambda t: t.value[1])))
+    ends = tuple(sorted(found, key=lambda t: t.value[1]))
+    return Walk(float(x.value), float(y.value), distance, ends, lo, hi)
+
+
+def _distance_range(problem: Problem, distance: Term) -> tuple[float, float]:
+    """The distance's range, narrowed by bounds ``D - low >= 0`` and ``high - D >= 0`` whose other
+    side depends on the other (bounded) variables only (``Range(d, 20)`` with ``d`` random)."""
+    lo, hi = problem.ranges[distance]
+    others = {u: Interval(*problem.ranges[u]) for u in problem.scalars if u is not distance}
+    evaluator = BoxEvaluator(None, others)  # type: ignore[arg-type]
+    for bound in problem.bounds:
+        term = bound.term
+        if term.op != "sub" or bound.lo != 0 or distance not in term.args or bound.hi != math.inf:
+            continue
+        side = term.args[1] if term.args[0] is distance else term.args[0]
+        if distance in side.leaves() or not side.leaves() <= set(others):
+            continue
+        enclosure = evaluator.num(side)
+        if enclosure is None:
+            continue
+        if term.args[0] is distance:
+            lo = max(lo, enclosure.lo)
+        else:
+            hi = min(hi, enclosure.hi)
+    return lo, hi
 
 
 def _follow_terms(problem: Problem) -> list[Term]:
@@ -82,7 +109,7 @@ def walk_pieces(problems: list[Problem], walks: list[Walk | None], geometry: Map
     rows = [k for k, walk in enumerate(walks) if walk is not None]
     if not rows:
         return {}
-    ranges = np.array([problems[k].ranges[walks[k].distance] for k in rows], dtype=float)  # type: ignore[union-attr]
+    ranges = np.array([(walks[k].lo, walks[k].hi) for k in rows], dtype=float)  # type: ignore[union-attr]
     starts = np.array([(walks[k].x, walks[k].y) for k in rows], dtype=float)  # type: ignore[union-attr]
     target = np.array([_target(problems[k], walks[k]) for k in rows], dtype=float)  # type: ignore[arg-type]
     pieces = follow_pieces(geometry, ROAD_DIRECTION, starts[:, 0], starts[:, 1], ranges[:, 0], ranges[:, 1], target)

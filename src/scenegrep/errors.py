@@ -78,3 +78,11 @@ def first_line(exc: BaseException) -> str:
     one-line report of a library's error."""
     text = str(exc).strip()
     return text.splitlines()[0] if text else type(exc).__name__
+
+
+def failure_text(exc: Exception, where: str | PathLike[str]) -> str:
+    """One line for an error that ends one source or trace while the others go on: a
+    :class:`UserError`'s own line, else ``WHERE: TYPE: MESSAGE`` (a bug, reported, not raised)."""
+    if isinstance(exc, UserError):
+        return exc.one_line()
+    return " ".join(f"{where}: {type(exc).__name__}: {exc}".split())

@@ -37,22 +37,29 @@ def run(args, capsys):
 def test_text_output_names_correspondence_and_values(files, capsys):
     code, lines, err = run([files / "ahead.scenic", files / "trace.json", "--map", files / "map.parquet"], capsys)
     assert code == 0 and len(lines) == 1
-    assert lines[0].startswith(f"{files / 'trace.json'}:0  ego=ego  other=c  |  ")
+    assert lines[0].startswith("hand:0-0  ego=ego  other=c  |  ")
     assert "Range(4, 10)@3:33=6" in lines[0]  # a 6 m gap
-    assert err == ["scenegrep: 1 of 2 frames match"]
+    assert err == ["scenegrep: 1 of 1 traces match, 0 pruned, 0 failed"]
 
 
-def test_json_explain_and_parquet(files, capsys):
+def test_json_output_and_explain(files, capsys):
     out = files / "matches.parquet"
-    args = [files / "ahead.scenic", files / "trace.json", "--map", files / "map.parquet", "--json", "--explain"]
-    code, lines, _ = run([*args, "--parquet", out], capsys)
-    records = [json.loads(line) for line in lines]
-    assert code == 0 and [r["match"] for r in records] == [True, False]
-    assert records[0]["correspondence"] == {"ego": "ego", "other": "c"}
-    assert records[0]["values"]["Range(4, 10)@3:33"] == pytest.approx(6.0)
-    assert "other.x, other.y" in records[1]["failure"]
+    args = [files / "ahead.scenic", files / "trace.json", "--map", files / "map.parquet", "--json"]
+    code, lines, _ = run([*args, "--output", out], capsys)
+    (record,) = [json.loads(line) for line in lines]
+    assert code == 0 and record["status"] == "match"
+    assert (record["start_frame"], record["end_frame"], record["start_time"], record["end_time"]) == (0, 0, 0.0, 0.0)
+    assert record["correspondence"] == {"ego": "ego", "other": "c"}
+    assert record["values"]["Range(4, 10)@3:33"] == pytest.approx(6.0)
     table = pq.read_table(out).to_pylist()
-    assert [(row["frame"], json.loads(row["correspondence"])["other"]) for row in table] == [(0, "c")]
+    assert [(row["start_frame"], json.loads(row["correspondence"])["other"]) for row in table] == [(0, "c")]
+    (files / "side.scenic").write_text(HEADER + "ego = new Car on road\nother = new Car left of ego by 3\n")
+    code, lines, _ = run([files / "side.scenic", *args[1:], "--explain"], capsys)
+    (record,) = [json.loads(line) for line in lines]
+    assert code == 1 and record["status"] == "no match"
+    assert record["explanation"].splitlines() == [
+        f"frame {f}: no labeled object can be other (Car, line 3): other.x" for f in (0, 1)
+    ]
 
 
 def test_exit_code_options_and_quiet(files, capsys):
@@ -65,25 +72,26 @@ def test_exit_code_options_and_quiet(files, capsys):
 
 
 @pytest.mark.parametrize(
-    ("text", "expected"),
+    ("text", "status", "expected"),
     [
-        ("ego = new Car on\n", "scenegrep: error: {p}:2:17: Scenic syntax error"),
-        ("import math\nego = new Car\n", "scenegrep: error: {p}:2:1: imports are not supported"),
-        ("ego = new Car on sidewalk\n", "scenegrep: error: {p}: the program names map layers"),
+        ("ego = new Car on\n", 2, "scenegrep: error: {p}:2:17: Scenic syntax error"),
+        ("import math\nego = new Car\n", 2, "scenegrep: error: {p}:2:1: imports are not supported"),
+        ("ego = new Car on sidewalk\n", 3, "scenegrep: failed: hand: {p}: the program names map layers"),
     ],
 )
-def test_errors_are_one_line_with_the_place(files, capsys, text, expected):
+def test_errors_are_one_line_with_the_place(files, capsys, text, status, expected):
+    """Errors in the program stop the command (2); one that a trace's map causes fails that trace (3)."""
     program = files / "bad.scenic"
     program.write_text(HEADER + text)
     code, _, err = run([program, files / "trace.json", "--map", files / "map.parquet"], capsys)
-    assert code == 2 and err[0].startswith(expected.format(p=program))
+    assert code == status and err[0].startswith(expected.format(p=program))
     assert not any("Traceback" in line for line in err)
 
 
 def test_missing_inputs(files, capsys):
     code, _, err = run([files / "absent.scenic", files / "trace.json"], capsys)
     assert code == 2 and err == [f"scenegrep: error: {files / 'absent.scenic'}: no such file"]
-    code, _, err = run([files / "ahead.scenic", files / "trace.json"], capsys)  # no map anywhere
-    assert code == 2 and "has no road map" in err[0]
+    code, _, err = run([files / "ahead.scenic", files / "trace.json"], capsys)  # no map anywhere: the trace fails
+    assert code == 3 and err[0].startswith("scenegrep: failed: hand: ") and "has no road map" in err[0]
     code, _, err = run([files / "ahead.scenic", files / "trace.json", "--tolerance-heading", "-1"], capsys)
     assert code == 2 and "must not be negative" in err[0]

@@ -20,10 +20,11 @@ def run(args, capsys):
 def test_text_json_and_export(conformance_dir, capsys):
     seq = str(conformance_dir / "strem/data/noncontig.json")
     code, lines, _ = run(["[[:car:]]{2}", seq], capsys)
-    assert (code, lines) == (0, [f"{seq}:10..21"])
+    assert (code, lines) == (0, ["noncontig:10-20"])
+    assert run(["--compat", "strem", "[[:car:]]{2}", seq], capsys)[:2] == (0, [f"{seq}:10..21"])
     code, lines, _ = run(["--json", "[[:car:]]{2}", seq], capsys)
     record = json.loads(lines[0])
-    assert record["start"] == 10 and record["end"] == 21 and record["frames"] == [10, 20]
+    assert (record["start_frame"], record["end_frame"], record["status"]) == (10, 20, "match")
     code, lines, _ = run(["--export", "[[:car:]]{2}", seq], capsys)
     exported = decode(lines[0].encode(), "<export>", "x")
     assert exported.frame_index.tolist() == [10, 20] and len(exported.images.boxes) == 2
@@ -33,13 +34,19 @@ def test_exit_codes_quiet_and_max_count(conformance_dir, capsys):
     seq = str(conformance_dir / "strem/data/seq_a.json")
     assert run(["[[:truck:]]", seq], capsys)[:2] == (1, [])
     assert run(["-q", "[[:car:]]", seq], capsys)[:2] == (0, [])
-    assert run(["-m", "1", "[[:car:]]", seq], capsys)[:2] == (0, [f"{seq}:0..1"])
+    assert run(["-m", "1", "[[:car:]]", seq], capsys)[:2] == (0, ["seq_a:0-0"])
+    assert run(["--compat", "strem", "-m", "1", "[[:car:]]", seq], capsys)[:2] == (0, [f"{seq}:0..1"])
     code, _, err = run(["[[:car:]", seq], capsys)
     assert code == 2 and err.startswith("scenegrep: error: <query>:1:9: ") and "^" in err
 
 
-def test_bad_file_is_a_one_line_error(conformance_dir, capsys):
-    code, _, err = run(["[[:car:]]", str(conformance_dir / "strem/data/fmt_missing_image.json")], capsys)
+def test_bad_file_is_a_one_line_failure_and_the_others_run(conformance_dir, capsys):
+    bad, good = (str(conformance_dir / f"strem/data/{name}.json") for name in ("fmt_missing_image", "seq_a"))
+    code, lines, err = run(["[[:car:]]", bad, good], capsys)
+    (failed,) = [line for line in err.splitlines() if "missing field `image`" in line]
+    assert code == 3 and failed.startswith("scenegrep: failed: fmt_missing_image.json: ") and lines
+    assert "Traceback" not in err
+    code, _, err = run(["--compat", "strem", "[[:car:]]", bad, good], capsys)  # STREM stops at the bad file
     assert code == 2 and err.count("\n") == 1 and "missing field `image`" in err
 
 
@@ -96,16 +103,16 @@ def test_online_stdin_constant_state(tmp_path):
         text=True,
         check=True,
     ).stdout.splitlines()
-    assert len(out) == 3000 and out[-1] == "0..3000"
+    assert len(out) == 3000 and out[-1] == "0-2999"
 
 
 @pytest.mark.parametrize(
-    "args, message",
+    "args, status, message",
     [
-        (["--space", "topdown", "[[:car:]]"], "top-down"),
-        (["--online", "--compat", "strem", "[[:car:]]{0}"], "0 frames online"),
+        (["--space", "topdown", "[[:car:]]"], 3, "top-down"),  # the stream has no objects: it fails
+        (["--online", "--compat", "strem", "[[:car:]]{0}"], 2, "0 frames online"),
     ],
 )
-def test_option_errors(conformance_dir, capsys, args, message):
+def test_option_errors(conformance_dir, capsys, args, status, message):
     code, _, err = run([*args, str(conformance_dir / "strem/data/seq_a.json")], capsys)
-    assert code == 2 and message in err
+    assert code == status and message in err

@@ -1,11 +1,14 @@
-"""``--dataset DATASET``: the options and output the query commands share when they run over a
-dataset (through :mod:`scenegrep.dataset`).
+"""What the query commands share: one run over DATA files or over an ``--dataset``, through the
+dataset engine either way (:func:`scenegrep.dataset.files.query_files`,
+:func:`scenegrep.dataset.run.run_query`), and one output of its results table.
 
 Output: one line per match ``NAME:START-END  correspondence`` (dataset frame indices of the
-window's first and last frame), or the whole results table with ``--json`` (one object per
-row) or ``--csv``; a summary and the pruning on stderr. Exit codes: 0 some trace matches,
-1 none, 2 user error, 3 some trace failed (its error is in the results), 130 interrupted
-(the results so far are kept; ``--resume`` continues).
+window's first and last frame, inclusive), or every row of the results table with ``--json``
+(one object per row) or ``--csv``; a failed trace's error and a summary on stderr. Over files,
+each trace's rows are printed as soon as it is done. ``--output FILE`` also writes the table as
+Parquet, which ``show``, ``report`` and ``export`` read. Exit codes: 0 some trace matches, 1 none,
+2 user error, 3 some path or trace failed (the others are done), 130 interrupted (a dataset
+run keeps the results so far; ``--resume`` continues).
 """
 
 from __future__ import annotations
@@ -22,51 +25,43 @@ NO_MATCH = 1
 
 
 def add_dataset_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options of a run over a dataset."""
-    group = parser.add_argument_group("datasets (scenegrep ingest)")
+    """The options of the results table and of a run over a dataset."""
+    group = parser.add_argument_group("results table (also over files) and datasets (scenegrep ingest)")
+    group.add_argument("--output", metavar="FILE", help="also write the results table to this Parquet file")
+    group.add_argument("--csv", action="store_true", help="print the results table as CSV")
     group.add_argument("--dataset", metavar="DATASET", help="query every trace of an ingested dataset")
     group.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes (default: all cores)")
     group.add_argument("--engine", choices=["local", "ray"], default="local", help="local processes or Ray")
     group.add_argument("--address", metavar="ADDR", help="Ray cluster address (default: start a local Ray)")
     group.add_argument("--resume", action="store_true", help="continue an interrupted run of the same query")
-    group.add_argument("--output", metavar="FILE", help="also write the results table to this Parquet file")
-    group.add_argument("--csv", action="store_true", help="print the results table as CSV")
 
 
 def reject_dataset_only(args: argparse.Namespace) -> None:
     """Dataset options given without --dataset are user errors."""
     from ..errors import UserError
 
-    for name in ("resume", "output", "csv"):
-        if getattr(args, name):
-            raise UserError(f"--{name} needs --dataset")
+    if args.resume:
+        raise UserError("--resume needs --dataset")
     if args.engine != "local" or args.jobs is not None or args.address:
         raise UserError("--jobs, --engine and --address need --dataset")
 
 
-def run_dataset(args: argparse.Namespace, kind: str, query: str, origin: str, options: dict[str, Any]) -> int:
-    """Run a query over ``args.dataset`` and print its results; returns the exit code."""
-    from pathlib import Path
-
+def run_query_command(
+    args: argparse.Namespace, kind: str, query: str, origin: str, options: dict[str, Any], paths: list[str]
+) -> int:
+    """Run a query over ``paths`` or ``args.dataset``, print its results; returns the exit code."""
     from ..dataset import QuerySpec
-    from ..dataset.run import RunOptions, run_query
-    from ..errors import UserError
 
-    if getattr(args, "data", None):
-        raise UserError("give either DATA paths or --dataset, not both")
     spec = QuerySpec.of(kind, query, origin, **options)
-    quiet = args.quiet
-    run = RunOptions(
-        args.jobs, args.engine, args.address, args.resume, getattr(args, "map", None), not quiet and sys.stderr.isatty()
-    )
-    results = run_query(Path(args.dataset).resolve(), spec, run, on_plan=None if quiet else _report_plan)
+    printer = RowPrinter(args)
+    if args.dataset:
+        results, where = _over_dataset(args, spec, paths, printer)
+    else:
+        results, where = _over_files(args, spec, paths, printer), ""
     if args.output:
         results.write_parquet(args.output)
-    if not quiet:
-        _print(results, args)
-        _summary(results, Path(args.dataset))
-        if kind != "spre" and not results.counts()["matched"]:
-            _misses(spec, results, Path(args.dataset).resolve(), args)
+    if not args.quiet:
+        _summary(results, where or (f"; results in {args.output}" if args.output else ""))
     counts = results.counts()
     if results.status == "interrupted":
         return EXIT_INTERRUPTED
@@ -75,14 +70,99 @@ def run_dataset(args: argparse.Namespace, kind: str, query: str, origin: str, op
     return 0 if counts["matched"] else NO_MATCH
 
 
-def _misses(spec: Any, results: Any, root: Any, args: argparse.Namespace) -> None:
-    """The nearest misses of a Scenic query that matched nothing in the dataset at ``root``."""
-    from ..dataset.misses import nearest_misses
-    from ..view.sources import load_trace
-    from .misses import print_misses, what_of
+def _over_files(args: argparse.Namespace, spec: Any, paths: list[str], printer: RowPrinter) -> Any:
+    from ..dataset.files import query_files
+    from ..errors import UserError
 
-    misses = nearest_misses(spec, results.table.to_pylist(), lambda trace_id: load_trace(root, trace_id))
-    print_misses(misses, what_of(spec.kind), args.json)
+    reject_dataset_only(args)
+    if not paths:
+        raise UserError("give DATA (trace files or directories) or --dataset")
+    return query_files(paths, spec, getattr(args, "map", None), printer)
+
+
+def _over_dataset(args: argparse.Namespace, spec: Any, paths: list[str], printer: RowPrinter) -> tuple[Any, str]:
+    from pathlib import Path
+
+    from ..dataset.run import RunOptions, run_query
+    from ..errors import UserError
+
+    if paths:
+        raise UserError("give either DATA paths or --dataset, not both")
+    quiet = args.quiet
+    run = RunOptions(
+        args.jobs, args.engine, args.address, args.resume, getattr(args, "map", None), not quiet and sys.stderr.isatty()
+    )
+    results = run_query(Path(args.dataset).resolve(), spec, run, on_plan=None if quiet else _report_plan)
+    printer(results.table.to_pylist())
+    state = " (interrupted: continue with --resume)" if results.status == "interrupted" else ""
+    where = (
+        f"{state}; results in {Path(args.dataset) / 'runs' / results.run_id / 'results.parquet'} "
+        f"and the catalog (SELECT * FROM results WHERE run_id = '{results.run_id}')"
+    )
+    return results, where
+
+
+class RowPrinter:
+    """Prints result rows as the options ask: text lines for matches (and, with ``--explain``,
+    the explanation of traces without one), or every row as JSON or CSV; failed rows' errors on
+    stderr; nothing with ``-q``. ``--max-count N`` prints at most N matches per trace."""
+
+    def __init__(self, args: argparse.Namespace):
+        from ..dataset.results import csv_writer
+
+        self.args = args
+        self.limit = getattr(args, "max_count", None)
+        self.explain = getattr(args, "explain", False)
+        self.write_csv = csv_writer(sys.stdout) if args.csv and not args.quiet else None
+
+    def __call__(self, rows: list[dict[str, Any]]) -> None:
+        """Print one trace's rows (or a whole table's)."""
+        if self.args.quiet:
+            return
+        from ..dataset.results import json_line
+
+        for row in rows:
+            if row["status"] == "failed":
+                print(f"scenegrep: failed: {row['name']}: {row['error']}", file=sys.stderr)
+            if self.limit is not None and row["match"] >= self.limit:
+                continue
+            if self.write_csv is not None:
+                self.write_csv(row)
+            elif self.args.json:
+                sys.stdout.write(json_line(row) + "\n")
+            else:
+                sys.stdout.write("".join(line + "\n" for line in self._lines(row)))
+        sys.stdout.flush()
+
+    def _lines(self, row: dict[str, Any]) -> list[str]:
+        explanation = (row["explanation"] or "").splitlines() if self.explain else []
+        if row["status"] == "no match" and explanation:
+            return [f"{row['name']}  no match: {explanation[0]}", *(f"    {line}" for line in explanation[1:])]
+        if row["status"] != "match":
+            return []
+        return [match_line(row), *(f"    {line}" for line in explanation)]
+
+
+def match_line(row: dict[str, Any]) -> str:
+    """``NAME:START-END  object=id ...  |  variable=value ...  [holds] require ...`` for a match row."""
+    pairs = "  ".join(f"{k}={v}" for k, v in json.loads(row["correspondence"] or "{}").items())
+    text = f"{row['name']}:{row['start_frame']}-{row['end_frame']}  {pairs}".rstrip()
+    values = json.loads(row.get("values") or "{}")
+    variables = {k: v for k, v in values.items() if not isinstance(v, bool)}
+    if variables:
+        text += "  |  " + "  ".join(f"{name}={_value_text(v)}" for name, v in variables.items())
+    soft = {k: v for k, v in values.items() if isinstance(v, bool)}
+    if soft:
+        text += "  |  " + "  ".join(f"[{'holds' if ok else 'fails'}] {name}" for name, ok in soft.items())
+    return text
+
+
+def _value_text(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, list):
+        return "(" + ", ".join("?" if c is None else f"{c:.6g}" for c in value) + ")"
+    return "?" if value is None else str(value)
 
 
 def _report_plan(plan: Any) -> None:
@@ -97,29 +177,10 @@ def _general(reason: str) -> str:
     return reason.split(" (at most")[0]
 
 
-def _print(results: Any, args: argparse.Namespace) -> None:
-    out = sys.stdout
-    if args.json:
-        results.write_json(out)
-        return
-    if args.csv:
-        results.write_csv(out)
-        return
-    for row in results.matches.to_pylist():
-        pairs = "  ".join(f"{k}={v}" for k, v in json.loads(row["correspondence"] or "{}").items())
-        out.write(f"{row['name']}:{row['start_frame']}-{row['end_frame']}  {pairs}".rstrip() + "\n")
-        for line in (row["explanation"] or "").splitlines() if getattr(args, "explain", False) else ():
-            out.write(f"    {line}\n")
-
-
-def _summary(results: Any, dataset: Any) -> None:
+def _summary(results: Any, where: str) -> None:
     counts = results.counts()
-    for row in results.failed.to_pylist():
-        print(f"scenegrep: failed: {row['name']}: {row['error']}", file=sys.stderr)
-    state = " (interrupted: continue with --resume)" if results.status == "interrupted" else ""
     print(
         f"scenegrep: {counts['matched']} of {counts['traces']} traces match, {counts['pruned']} pruned, "
-        f"{counts['failed']} failed{state}; results in {dataset / 'runs' / results.run_id / 'results.parquet'} "
-        f"and the catalog (SELECT * FROM results WHERE run_id = '{results.run_id}')",
+        f"{counts['failed']} failed{where}",
         file=sys.stderr,
     )

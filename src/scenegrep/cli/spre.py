@@ -1,8 +1,12 @@
 """``scenegrep spre PATTERN [FILE...]``: Spatial Regular Expression matching, offline and online.
 
-Output is one line per match, ``PATH:START..END`` (frame indices, half-open; no path for
-standard input), or with ``--json`` one JSON object per match. Exit codes: 0 some match,
-1 none, 2 error.
+Over files, the dataset engine's query (:mod:`.dataset_run`): one line per match,
+``NAME:START-END`` (dataset frame indices of the first and last frame), or the results table
+with ``--json``, ``--csv`` or ``--output``; a bad file is a failed row (exit code 3). As STREM
+does (``--compat strem``, ``--online``, ``--export``, standard input): each stream searched as it
+is read, ``PATH:START-END`` (``PATH:START..END``, STREM's first index .. last index + 1, with
+``--compat strem``; no path for standard input), and the first bad input ends the command (exit
+code 2). Exit codes: 0 some match, 1 none, 2 error, 3 some file failed.
 """
 
 from __future__ import annotations
@@ -12,7 +16,7 @@ import json
 import sys
 from typing import Any
 
-from .dataset_run import add_dataset_arguments, reject_dataset_only, run_dataset
+from .dataset_run import add_dataset_arguments, reject_dataset_only, run_query_command
 
 NO_MATCH = 1
 
@@ -61,24 +65,23 @@ def _export(match: Any, trace: Any, options: Any) -> dict[str, Any]:
 
 
 def _line(match: Any, prefix: str, args: argparse.Namespace, trace: Any, options: Any) -> str:
-    start, end = match.index_range
     if args.json:
         record: dict[str, Any] = {
             "source": prefix or "<stdin>",
-            "start": start,
-            "end": end,
+            "start_frame": match.first_index,
+            "end_frame": match.last_index,
             "start_time": match.start_time,
             "end_time": match.end_time,
         }
         if trace is not None:
             record["trace"] = trace.name
-            record["frames"] = trace.frame_index[match.start : match.end].tolist()
         if match.bound:
             record["bound"] = match.bound
         return json.dumps(record, allow_nan=True)
     if args.export and trace is not None:
         return json.dumps(_export(match, trace, options), separators=(",", ":"), allow_nan=True)
-    return f"{prefix}:{start}..{end}" if prefix else f"{start}..{end}"
+    span = "{}..{}".format(*match.index_range) if args.compat == "strem" else f"{match.first_index}-{match.last_index}"
+    return f"{prefix}:{span}" if prefix else span
 
 
 def _report(matches: Any, prefix: str, args: argparse.Namespace, options: Any, trace: Any = None) -> bool:
@@ -99,28 +102,37 @@ def _report(matches: Any, prefix: str, args: argparse.Namespace, options: Any, t
     return found
 
 
-def _run_dataset(args: argparse.Namespace) -> int:
+def _streams(args: argparse.Namespace) -> bool:
+    """Whether the command searches streams as STREM does (``--compat strem``, ``--online``,
+    ``--export`` or standard input), printing each file's matches as found and stopping at the
+    first bad input, rather than running the dataset engine's query over files."""
+    return args.compat == "strem" or args.online or args.export or not args.files or "-" in args.files
+
+
+def run(args: argparse.Namespace) -> int:
     from ..errors import UserError
 
-    if args.online or args.export or args.max_count is not None:
-        raise UserError("--online, --export and --max-count read files; with --dataset use the results table")
+    if not args.dataset and _streams(args):
+        reject_dataset_only(args)
+        if args.output or args.csv:
+            raise UserError("--output and --csv give the results table: not with --compat, --online, --export or stdin")
+        return _run_streams(args)
+    if args.online or args.export:
+        raise UserError("--online and --export read files; with --dataset use the results table")
     options = {
         "compat": args.compat == "strem",
         "space": args.space,
         "channels": tuple(args.channel) if args.channel else None,
         "skip": args.skip,
     }
-    return run_dataset(args, "spre", args.pattern, "<query>", options)
+    return run_query_command(args, "spre", args.pattern, "<query>", options, args.files)
 
 
-def run(args: argparse.Namespace) -> int:
+def _run_streams(args: argparse.Namespace) -> int:
     from .. import readers
     from ..readers.strem_json import iter_documents
     from ..spre import SearchOptions, TraceSearch, compile_query, search_stream
 
-    if args.dataset:
-        return _run_dataset(args)
-    reject_dataset_only(args)
     query = compile_query(args.pattern, compat=args.compat == "strem")
     for warning in query.warnings:
         print(f"scenegrep: warning: {warning}", file=sys.stderr)

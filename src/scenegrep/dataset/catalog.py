@@ -12,7 +12,8 @@ Tables (``trace_id`` joins them; frames are positions 0..F-1 of a trace, times s
   or image boxes ('images') of each class in each frame where there is any.
 - ``labels(trace_id, label, observations, objects)``: behaviour label statistics.
 - ``runs(run_id, kind, query, options, status, started_at, finished_at, traces, pruned, matched,
-  failed)`` and ``results(run_id, trace_id, ...)``: query runs and their results table.
+  failed)`` and ``results(run_id, trace_id, ...)``: query runs and their results table (the columns
+  of :data:`scenegrep.dataset.queries.RESULTS_SCHEMA`).
 
 A trace is visible when its ``traces`` row is committed; its rows of every table are written
 in one transaction, after its Parquet file is complete.
@@ -56,6 +57,7 @@ CREATE TABLE IF NOT EXISTS results (
     run_id VARCHAR, trace_id VARCHAR, name VARCHAR, source VARCHAR, status VARCHAR, match INTEGER,
     correspondence VARCHAR, start_frame BIGINT, end_frame BIGINT, start_time DOUBLE, end_time DOUBLE,
     time_origin_ns BIGINT, explanation VARCHAR, error VARCHAR);
+ALTER TABLE results ADD COLUMN IF NOT EXISTS values VARCHAR;
 """
 
 PER_TRACE_TABLES = ("objects", "frame_counts", "labels")
@@ -69,17 +71,18 @@ class Catalog:
     """A connection to a dataset's catalog; use as a context manager (commits on close).
 
     ``read_only`` connections may be open in several processes at once; a writing connection
-    excludes every other process (DuckDB's file lock), so long runs close it while they work."""
+    excludes every other process (DuckDB's file lock), so long runs close it while they work.
+    A ``root`` of None is a catalog in memory (a query over files plans each trace with one)."""
 
-    def __init__(self, root: Path, create: bool = False, read_only: bool = False):
+    def __init__(self, root: Path | None, create: bool = False, read_only: bool = False):
         self.root = root
-        path = root / CATALOG_FILE
-        if not create and not path.is_file():
+        path = None if root is None else root / CATALOG_FILE
+        if path is not None and not create and not path.is_file():
             raise UserError("not a scenegrep dataset (no catalog.duckdb; create one with scenegrep ingest)", at(root))
-        if create:
-            root.mkdir(parents=True, exist_ok=True)
+        if path is not None and create:
+            path.parent.mkdir(parents=True, exist_ok=True)
         try:
-            self.db = duckdb.connect(str(path), read_only=read_only)
+            self.db = duckdb.connect(":memory:" if path is None else str(path), read_only=read_only)
         except duckdb.IOException as exc:
             raise UserError(f"cannot open the catalog: {str(exc).splitlines()[0]}", at(path)) from None
         if not read_only:
@@ -176,7 +179,7 @@ class Catalog:
         try:
             db.execute("DELETE FROM results WHERE run_id = ?", [run_id])
             db.register("incoming", results)
-            db.execute("INSERT INTO results SELECT ?, * FROM incoming", [run_id])
+            db.execute("INSERT INTO results BY NAME SELECT ? AS run_id, * FROM incoming", [run_id])
             db.unregister("incoming")
             db.execute(
                 "UPDATE runs SET status = ?, finished_at = now(), traces = ?, pruned = ?, matched = ?, failed = ? "

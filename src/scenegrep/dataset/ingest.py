@@ -23,7 +23,8 @@ from pathlib import Path
 from typing import Any
 
 from .. import readers
-from ..errors import UserError, at
+from ..errors import UserError, at, failure_text
+from ..model import LabelTrace, RoadMap
 from ..readers.trace_folder import SKIPPED
 from .catalog import Catalog
 from .execute import run_all
@@ -167,35 +168,48 @@ def ingest_source(task: IngestTask) -> SourceOutcome:
         for number, trace in enumerate(readers.read_traces(source.path, source.format)):
             outcome.traces.append(_write_trace(trace, number, task, outcome.maps))
         return outcome
-    except UserError as exc:
-        return SourceOutcome(source, "failed", error=exc.one_line())
-    except Exception as exc:  # a reader's bug must not stop the other sources
-        return SourceOutcome(source, "failed", error=f"{source.path}: {type(exc).__name__}: {exc}")
+    except Exception as exc:  # a bad source, or a reader's bug, must not stop the other sources
+        return SourceOutcome(source, "failed", error=failure_text(exc, source.path))
 
 
-def _write_trace(trace: Any, number: int, task: IngestTask, maps: list[dict[str, Any]]) -> tuple[dict, Any]:
-    from ..writers.trace_parquet import write_map_parquet, write_trace_parquet
-
-    root = Path(task.root)
-    map_id = road_map = None
-    if trace.map_source is not None:
-        map_id = map_id_of(trace.map_source)
-        map_file = f"{MAPS_DIR}/{map_id}.parquet"
-        road_map = readers.read_map(trace.map_source)
-        if not (root / map_file).is_file():
-            write_map_parquet(road_map, root / map_file)
-        ms = trace.map_source
-        maps.append({"map_id": map_id, "file": map_file, "source_path": ms.path, "format": ms.format, "key": ms.key})
-    if task.label and trace.behaviours is None:
+def prepare_trace(trace: LabelTrace, label: bool) -> tuple[LabelTrace, RoadMap | None]:
+    """A trace as a dataset holds it, and its own road map (None when it names none): when
+    ``label`` and it has no behaviour labels, labelled with that map by ``scenegrep label``'s
+    labeller. Ingest and a query over files both read traces this way."""
+    road_map = None if trace.map_source is None else readers.read_map(trace.map_source)
+    if label and trace.behaviours is None:
         from ..label import label_trace
 
         trace = label_trace(trace, road_map).trace
+    return trace, road_map
+
+
+def catalog_row(
+    trace: LabelTrace, trace_id: str, source_path: str, file: str, map_id: str | None
+) -> tuple[dict[str, Any], TraceStatistics]:
+    """A trace's ``traces`` row in the catalog and its statistics."""
+    stats = TraceStatistics.of(trace)
+    row = {"trace_id": trace_id, **stats.trace, "source_path": source_path, "file": file, "map_id": map_id}
+    return row, stats
+
+
+def _write_trace(trace: LabelTrace, number: int, task: IngestTask, maps: list[dict[str, Any]]) -> tuple[dict, Any]:
+    from ..writers.trace_parquet import write_map_parquet, write_trace_parquet
+
+    root = Path(task.root)
+    trace, road_map = prepare_trace(trace, task.label)
+    map_id = None
+    if road_map is not None:
+        ms = trace.map_source
+        map_id = map_id_of(ms)
+        map_file = f"{MAPS_DIR}/{map_id}.parquet"
+        if not (root / map_file).is_file():
+            write_map_parquet(road_map, root / map_file)
+        maps.append({"map_id": map_id, "file": map_file, "source_path": ms.path, "format": ms.format, "key": ms.key})
     trace_id = trace_id_of(task.source.path, trace.name, number)
     file = f"{TRACES_DIR}/{trace_id}.parquet"
     write_trace_parquet(trace, root / file)
-    stats = TraceStatistics.of(trace)
-    row = {"trace_id": trace_id, **stats.trace, "source_path": task.source.path, "file": file, "map_id": map_id}
-    return row, stats
+    return catalog_row(trace, trace_id, task.source.path, file, map_id)
 
 
 def _remove_stale_temporaries(root: Path) -> None:

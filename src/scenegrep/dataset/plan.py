@@ -73,12 +73,12 @@ def _frames(window: Any) -> int | str:
     try:
         if text == "all":
             return text
-        if text.endswith("s"):
-            float(text[:-1])
-            return text
-        return int(text)
+        length = float(text[:-1]) if text.endswith("s") else int(text)
     except ValueError:
         raise UserError(f"bad window {window!r}: give frames (50), seconds (5s) or 'all'") from None
+    if not length > 0:
+        raise UserError(f"the window must be at least one frame (got {window!r})")
+    return text if text.endswith("s") else int(length)
 
 
 def kind_groups(objects: list[Any]) -> tuple[KindGroup, ...]:
@@ -161,3 +161,15 @@ def _prune_by_classes(catalog: Catalog, classes: frozenset[str]) -> dict[str, st
         for (trace_id,) in catalog.rows(query, [name, name]):
             reasons.setdefault(trace_id, f"no object or box of class {name!r}")
     return reasons
+
+
+def prune_reason(needs: Needs, row: dict[str, Any], statistics: Any) -> str | None:
+    """Why :func:`plan` would prune one trace, given its ``traces`` row and its
+    :class:`~scenegrep.dataset.statistics.TraceStatistics`, or None: the same SQL, on a catalog
+    in memory that holds only this trace (a query over files plans each trace this way)."""
+    if not needs.groups and not needs.classes:
+        return None
+    with Catalog(None, create=True) as catalog:
+        catalog.replace_sources([({"path": row["source_path"], "format": "", "checksum": ""}, [(row, statistics)])])
+        pruned = plan(catalog, needs).pruned
+    return pruned[0][1] if pruned else None

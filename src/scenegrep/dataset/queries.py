@@ -8,19 +8,25 @@ Results table (one row per match; a trace without a match has one row with ``mat
 binders' variables), ``start_frame``/``end_frame`` (dataset frame indices of the window's first
 and last frame, inclusive), ``start_time``/``end_time`` (seconds from the trace's start),
 ``time_origin_ns`` (the trace's absolute time 0), ``explanation`` (with ``explain``: the
-witness of a match or why the trace does not match; for pruned traces, why), ``error``.
+witness of a match or why the trace does not match; for pruned traces, why), ``error``, and
+``values`` (scene matches with ``values``: JSON object of the program's random variables' values
+that reproduce the frame, and each soft requirement's truth).
+
+One trace's rows come from :func:`query_trace` whether the trace was ingested (a dataset run)
+or read from a file (:mod:`scenegrep.dataset.files`).
 """
 
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
 
-from ..errors import UserError, at
+from ..errors import UserError, failure_text
 from ..model import LabelTrace, RoadMap
 
 KINDS = ("scenario", "scene", "spre")
@@ -40,8 +46,12 @@ RESULTS_SCHEMA = pa.schema(
         ("time_origin_ns", pa.int64()),
         ("explanation", pa.string()),
         ("error", pa.string()),
+        ("values", pa.string()),
     ]
 )
+
+ORDER = [("trace_id", "ascending"), ("match", "ascending")]
+"""The order of a results table's rows."""
 
 OPTIONS: dict[str, dict[str, Any]] = {
     "scenario": {
@@ -63,6 +73,7 @@ OPTIONS: dict[str, dict[str, Any]] = {
         "visible_distance": None,
         "exact": False,
         "explain": False,
+        "values": False,
     },
     "spre": {"compat": False, "space": None, "channels": None, "skip": 0},
 }
@@ -191,10 +202,13 @@ def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMa
 
     options = SceneOptions(spec_tolerance(spec), spec.option("exact"), spec.option("visible_distance"))
     result = query.match(trace, road_map, options)
-    rows = [
-        _window(trace, number, frame, frame, result.correspondence(frame))
-        for number, frame in enumerate(result.frames().tolist())
-    ]
+    rows = []
+    for number, frame in enumerate(result.frames().tolist()):
+        row = _window(trace, number, frame, frame, result.correspondence(frame))
+        if spec.option("values"):
+            soft = {name: bool(holds[number]) for name, holds in result.soft.items()}
+            row["values"] = json.dumps(result.values(frame) | soft, allow_nan=True)
+        rows.append(row)
     if not rows and spec.option("explain"):
         failures = (f"frame {int(trace.frame_index[f])}: {result.failure(f)}" for f in range(trace.n_frames))
         return [{"status": "no match", "match": -1, "explanation": "\n".join(failures)}]
@@ -208,9 +222,15 @@ def _scenario_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: Roa
         from ..label import label_trace
 
         trace = label_trace(trace, road_map).trace
-    find_all, explain = spec.option("all"), spec.option("explain")
-    options = ScenarioOptions(spec_tolerance(spec), spec.option("visible_distance"), find_all)
+    options = ScenarioOptions(spec_tolerance(spec), spec.option("visible_distance"), spec.option("all"))
     result = query.match(trace, spec.option("window"), road_map, options)
+    return scenario_rows(result, spec.option("all"), spec.option("explain"))
+
+
+def scenario_rows(result: Any, find_all: bool, explain: bool) -> list[dict[str, Any]]:
+    """The rows of a scenario query's result on one trace (empty: no match, unless ``explain``):
+    every window with ``find_all``, else the first."""
+    trace = result.trace
     rows = []
     for number, (match, first, last) in enumerate(result.windows()):
         row = _window(trace, number, first, last, match.correspondence)
@@ -222,6 +242,24 @@ def _scenario_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: Roa
     if not rows and explain:
         return [{"status": "no match", "match": -1, "explanation": result.why_not()}]
     return rows
+
+
+def query_trace(
+    identity: dict[str, Any], where: str, rows: Callable[[], list[dict[str, Any]]]
+) -> list[dict[str, Any]]:
+    """One trace's result rows, each with the trace's ``identity`` (trace_id, name, source,
+    time_origin_ns): ``rows()`` loads and queries the trace; if it raises, the trace gets one
+    'failed' row whose error names ``where``, and the caller goes on with the next trace."""
+    try:
+        found = rows()
+    except Exception as exc:  # one broken trace must not stop the others
+        found = [{"status": "failed", "match": -1, "error": failure_text(exc, where)}]
+    return [{**identity, **row} for row in found]
+
+
+def pruned_row(reason: str) -> dict[str, Any]:
+    """The row of a trace the planner pruned (it cannot match), with the reason."""
+    return {"status": "pruned", "match": -1, "explanation": reason}
 
 
 @dataclass(frozen=True)
@@ -239,23 +277,25 @@ class TraceTask:
 def run_tasks(work: tuple[QuerySpec, str | None, list[TraceTask]]) -> list[dict[str, Any]]:
     """Query a chunk of traces (runs in a worker): ``work`` is the spec, a fallback map path for
     traces without one, and the tasks. A trace that fails to load or query gives a 'failed' row."""
-    from .. import readers
-
     spec, fallback_map, tasks = work
     rows = []
     for task in tasks:
-        identity = {"trace_id": task.trace_id, "name": task.name, "source": task.source}
-        try:
-            trace = readers.read_trace(task.file, "scenegrep-parquet")
-            map_path = task.map_file or fallback_map
-            road_map = readers.read_map(map_path) if map_path else None
-            found = match_trace(spec, trace, road_map)
-        except UserError as exc:
-            found = [{"status": "failed", "match": -1, "error": exc.one_line()}]
-        except Exception as exc:  # one broken trace must not stop the run
-            found = [{"status": "failed", "match": -1, "error": f"{at(task.file)}: {type(exc).__name__}: {exc}"}]
-        rows.extend({**identity, "time_origin_ns": task.time_origin_ns, **row} for row in found)
+        identity = {
+            "trace_id": task.trace_id,
+            "name": task.name,
+            "source": task.source,
+            "time_origin_ns": task.time_origin_ns,
+        }
+        rows.extend(query_trace(identity, task.file, lambda task=task: _task_rows(spec, task, fallback_map)))
     return rows
+
+
+def _task_rows(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> list[dict[str, Any]]:
+    from .. import readers
+
+    trace = readers.read_trace(task.file, "scenegrep-parquet")
+    map_path = task.map_file or fallback_map
+    return match_trace(spec, trace, readers.read_map(map_path) if map_path else None)
 
 
 def results_table(rows: list[dict[str, Any]]) -> pa.Table:

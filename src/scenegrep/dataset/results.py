@@ -6,6 +6,7 @@ import csv
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from collections.abc import Callable
 from typing import Any, TextIO
 
 import pyarrow as pa
@@ -50,6 +51,8 @@ class Results:
                 table = pq.read_table(path)
         except (OSError, ValueError, pa.ArrowException) as exc:
             raise UserError(f"cannot read results: {str(exc).splitlines()[0]}", at(path)) from None
+        for name in set(LATER_COLUMNS) - set(table.column_names):
+            table = table.append_column(name, pa.nulls(table.num_rows, pa.string()))
         missing = set(RESULTS_SCHEMA.names) - set(table.column_names)
         if missing:
             raise UserError(f"not a scenegrep results table (no column {sorted(missing)[0]!r})", at(path))
@@ -98,17 +101,15 @@ class Results:
         }
 
     def write_json(self, stream: TextIO) -> None:
-        """One JSON object per row (correspondence decoded)."""
+        """One JSON object per row (:func:`json_line`)."""
         for row in self.table.to_pylist():
-            row["correspondence"] = json.loads(row["correspondence"]) if row["correspondence"] else None
-            stream.write(json.dumps(row, allow_nan=True) + "\n")
+            stream.write(json_line(row) + "\n")
 
     def write_csv(self, stream: TextIO) -> None:
-        """The table as CSV with a header row."""
-        writer = csv.writer(stream, lineterminator="\n")
-        writer.writerow(self.table.column_names)
+        """The table as CSV with a header row (:func:`csv_writer`)."""
+        write = csv_writer(stream)
         for row in self.table.to_pylist():
-            writer.writerow(["" if v is None else v for v in row.values()])
+            write(row)
 
     def write_parquet(self, path: str | Path) -> None:
         """The table as a Parquet file, written atomically."""
@@ -119,13 +120,38 @@ class Results:
             pq.write_table(self.table.replace_schema_metadata(metadata), tmp, compression="zstd")
 
 
+LATER_COLUMNS = ("values",)
+"""Columns added after results files were first written: null when a file lacks them."""
+
+JSON_COLUMNS = ("correspondence", "values")
+"""Columns holding JSON text, written as JSON values in JSON lines."""
+
+
+def json_line(row: dict[str, Any]) -> str:
+    """A results row as one JSON object, its JSON columns decoded (``Results.read`` reads it back)."""
+    decoded = {k: (json.loads(v) if v else None) if k in JSON_COLUMNS else v for k, v in row.items()}
+    return json.dumps(decoded, allow_nan=True)
+
+
+def csv_writer(stream: TextIO) -> Callable[[dict[str, Any]], None]:
+    """Writes the header row of the results' columns, and returns a function that writes a row."""
+    writer = csv.writer(stream, lineterminator="\n")
+    writer.writerow(RESULTS_SCHEMA.names)
+
+    def write(row: dict[str, Any]) -> None:
+        writer.writerow(["" if row.get(name) is None else row[name] for name in RESULTS_SCHEMA.names])
+
+    return write
+
+
 def _json_rows(path: str | Path) -> list[dict[str, Any]]:
     """The rows of a JSON-lines results file (as ``write_json`` writes them)."""
     with open(path, encoding="utf-8") as stream:
         rows = [json.loads(line) for line in stream if line.strip()]
     for row in rows:
-        if isinstance(row.get("correspondence"), dict):
-            row["correspondence"] = json.dumps(row["correspondence"], sort_keys=True)
+        for name in JSON_COLUMNS:
+            if isinstance(row.get(name), dict):
+                row[name] = json.dumps(row[name], sort_keys=name == "correspondence", allow_nan=True)
     return rows
 
 
@@ -141,8 +167,8 @@ def _text(value: Any) -> str | None:
 
 def _from_rows(rows: list[dict[str, Any]]) -> pa.Table:
     """Rows of text or JSON values as a table of the results' types."""
-    if rows and not set(RESULTS_SCHEMA.names) <= set(rows[0]):
-        missing = sorted(set(RESULTS_SCHEMA.names) - set(rows[0]))
+    if rows and not set(RESULTS_SCHEMA.names) - set(LATER_COLUMNS) <= set(rows[0]):
+        missing = sorted(set(RESULTS_SCHEMA.names) - set(LATER_COLUMNS) - set(rows[0]))
         raise ValueError(f"not a scenegrep results table (no column {missing[0]!r})")
     columns = {
         field.name: pa.array([_text(row.get(field.name)) for row in rows], pa.string()).cast(field.type)

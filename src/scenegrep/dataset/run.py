@@ -27,7 +27,7 @@ import pyarrow.parquet as pq
 from .catalog import Catalog
 from .execute import default_jobs, run_all
 from .plan import Plan, needs_of, plan
-from .queries import QuerySpec, TraceTask, compiled, results_table, run_tasks
+from .queries import ORDER, QuerySpec, TraceTask, compiled, pruned_row, results_table, run_tasks
 from .results import RESULTS_FILE, Results
 
 MAX_CHUNK = 64
@@ -75,6 +75,16 @@ def run_query(
     todo = [_task(root, row, maps) for row in planned.kept if row["trace_id"] not in done]
     status = _execute(spec, todo, parts, options, len(planned.kept), len(done))
     return _finish(root, run_id, status, parts, planned)
+
+
+def identity_of(row: dict[str, Any]) -> dict[str, Any]:
+    """The identity columns of a trace's result rows, from its ``traces`` row in the catalog."""
+    return {
+        "trace_id": row["trace_id"],
+        "name": row["name"],
+        "source": row["source_path"],
+        "time_origin_ns": row["time_origin_ns"],
+    }
 
 
 def _task(root: Path, row: dict[str, Any], maps: dict[str, str]) -> TraceTask:
@@ -129,21 +139,8 @@ def _execute(spec: QuerySpec, todo: list[TraceTask], parts: Path, options: RunOp
 def _finish(root: Path, run_id: str, status: str, parts: Path, planned: Plan) -> Results:
     """Gather the parts and the pruned traces into the results; write them out and to the catalog."""
     tables = [pq.read_table(p) for p in sorted(parts.glob("*.parquet"))]
-    pruned = [
-        {
-            "trace_id": row["trace_id"],
-            "name": row["name"],
-            "source": row["source_path"],
-            "status": "pruned",
-            "match": -1,
-            "time_origin_ns": row["time_origin_ns"],
-            "explanation": reason,
-        }
-        for row, reason in planned.pruned
-    ]
-    table = pa.concat_tables([results_table(pruned), *tables]).sort_by(
-        [("trace_id", "ascending"), ("match", "ascending")]
-    )
+    pruned = [{**identity_of(row), **pruned_row(reason)} for row, reason in planned.pruned]
+    table = pa.concat_tables([results_table(pruned), *tables]).sort_by(ORDER)
     results = Results(table, run_id, status)
     results.write_parquet(root / "runs" / run_id / RESULTS_FILE)
     with Catalog(root) as catalog:

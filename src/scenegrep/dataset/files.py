@@ -1,0 +1,90 @@
+"""A query over files: the dataset engine's per-trace path for traces that are not ingested.
+
+The sources under the given paths are found as ``ingest`` finds them
+(:func:`.ingest.discover`); each trace is read as ingest reads it (its own road map; labelled
+when it has no behaviour labels: :func:`.ingest.prepare_trace`), planned with the planner's SQL
+on a catalog in memory (:func:`.plan.prune_reason`), and queried by the engine's per-trace
+function (:func:`.queries.query_trace`). So its rows, trace ids included, equal those of the
+same query over a dataset that ingested the same paths. A path, source or trace that fails gives
+a 'failed' row and the others go on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+from .. import readers
+from ..errors import failure_text
+from ..model import LabelTrace
+from .ingest import Source, catalog_row, discover, prepare_trace, trace_id_of
+from .plan import Needs, needs_of, prune_reason
+from .queries import ORDER, QuerySpec, compiled, match_trace, pruned_row, query_trace, results_table
+from .results import Results
+from .run import run_id_of
+from .statistics import time_origin_ns
+
+RowsCallback = Callable[[list[dict[str, Any]]], None]
+
+
+def query_files(
+    paths: list[str], spec: QuerySpec, map_path: str | None = None, on_rows: RowsCallback | None = None
+) -> Results:
+    """Run ``spec`` over every trace under ``paths``; ``map_path`` is the road map of traces
+    without their own. ``on_rows`` sees each trace's rows (a failed path's or source's row) as
+    soon as they are ready. The results are ordered as a dataset run's, with its run id."""
+    needs = needs_of(spec, compiled(spec))
+    sources, bad = discover(paths)
+    rows: list[dict[str, Any]] = []
+    for batch in _batches(spec, needs, sources, bad, map_path):
+        rows.extend(batch)
+        if on_rows is not None:
+            on_rows(batch)
+    return Results(results_table(rows).sort_by(ORDER), run_id_of(spec))
+
+
+def _batches(
+    spec: QuerySpec, needs: Needs, sources: list[Source], bad: list[tuple[str, str]], map_path: str | None
+) -> Iterator[list[dict[str, Any]]]:
+    """The rows of each bad path, then of each trace of each source, in order."""
+    for path, error in bad:
+        yield [_failed(path, 0, error)]
+    for source in sources:
+        yield from _source_rows(spec, needs, source, map_path)
+
+
+def _failed(path: str, number: int, error: str) -> dict[str, Any]:
+    """The row of a path or source that gave no trace (or stopped giving them) at ``number``."""
+    name = Path(path).name
+    identity = {"trace_id": trace_id_of(path, name, number), "name": name, "source": path, "time_origin_ns": 0}
+    return {**identity, "status": "failed", "match": -1, "error": error}
+
+
+def _source_rows(spec: QuerySpec, needs: Needs, source: Source, map_path: str | None) -> Iterator[list[dict[str, Any]]]:
+    """Each trace's rows of one source, then, if reading it failed, the source's failed row."""
+    number = 0
+    try:
+        for number, trace in enumerate(readers.read_traces(source.path, source.format)):
+            yield _trace_rows(spec, needs, source.path, number, trace, map_path)
+    except Exception as exc:  # a bad source must not stop the others
+        yield [_failed(source.path, number, failure_text(exc, source.path))]
+
+
+def _trace_rows(
+    spec: QuerySpec, needs: Needs, source: str, number: int, trace: LabelTrace, map_path: str | None
+) -> list[dict[str, Any]]:
+    trace_id = trace_id_of(source, trace.name, number)
+    identity = {"trace_id": trace_id, "name": trace.name, "source": source, "time_origin_ns": time_origin_ns(trace)}
+
+    def rows() -> list[dict[str, Any]]:
+        prepared, road_map = prepare_trace(trace, label=True)
+        row, statistics = catalog_row(prepared, trace_id, source, "", None)
+        reason = prune_reason(needs, row, statistics)
+        if reason is not None:
+            return [pruned_row(reason)]
+        if road_map is None and map_path:
+            road_map = readers.read_map(map_path)
+        return match_trace(spec, prepared, road_map)
+
+    return query_trace(identity, source, rows)

@@ -55,11 +55,15 @@ def test_json_output_and_explain(files, capsys):
     assert [(row["start_frame"], json.loads(row["correspondence"])["other"]) for row in table] == [(0, "c")]
     (files / "side.scenic").write_text(HEADER + "ego = new Car on road\nother = new Car left of ego by 3\n")
     code, lines, _ = run([files / "side.scenic", *args[1:], "--explain"], capsys)
-    (record,) = [json.loads(line) for line in lines]
-    assert code == 1 and record["status"] == "no match"
-    assert record["explanation"].splitlines() == [
-        f"frame {f}: no labeled object can be other (Car, line 3): other.x" for f in (0, 1)
+    records = [json.loads(line) for line in lines]
+    assert code == 1 and [(r["status"], r["start_frame"], r["end_frame"]) for r in records] == [
+        ("no match", 0, 0),
+        ("no match", 1, 1),
     ]
+    assert {r["explanation"] for r in records} == {"no labeled object can be other (Car, line 3): other.x"}
+    code, lines, _ = run([*args[:-1], "--explain"], capsys)  # a match, and why the other frame is none
+    assert code == 0 and lines[0].startswith("hand:0-0  ego=ego  other=c  |  ")
+    assert lines[1].startswith("hand:1-1  no match: ") and "other.x, other.y" in lines[1]
 
 
 def test_exit_code_options_and_quiet(files, capsys):

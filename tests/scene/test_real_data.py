@@ -457,9 +457,9 @@ def test_fig3_explains_a_car_inside_the_intersection(real_data, capsys):
     program = str(EXAMPLES / "fig3_car_ahead.scenic")
     options = ["--visible-distance", "50", "--tolerance-position", "1", "--tolerance-heading", str(15 * DEG)]
     assert main(["scene", program, str(path), *options, "--explain", "--json", "--no-values"]) == 0
-    records = {r["frame"]: r for r in map(json.loads, capsys.readouterr().out.splitlines())}
-    assert not records[151]["match"]
-    assert "require not (otherCar in intersection)" in records[151]["failure"]
+    records = {r["start_frame"]: r for r in map(json.loads, capsys.readouterr().out.splitlines())}
+    assert records[151]["status"] == "no match" and records[140]["status"] == "match"
+    assert "require not (otherCar in intersection)" in records[151]["explanation"]
     hand = hand_of(path)
     car = "c1958768d48640948f6053d04cffd35b"
     assert records[140]["correspondence"]["otherCar"] == car
@@ -475,14 +475,14 @@ def test_scenario_3_explains_why_the_ego_is_not_against_traffic(real_data, capsy
     program = str(EXAMPLES / "s3_wrong_way.scenic")
     assert main(["scene", program, str(path), "--visible-distance", "50", "--explain", "--json"]) == 1
     records = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    assert len(records) == 196 and not any(r["match"] for r in records)
+    assert len(records) == 196 and {r["status"] for r in records} == {"no match"}
     hand = hand_of(path)
     for r in records:
-        ego = hand.frames[r["frame"]]["ego"]
+        ego = hand.frames[r["start_frame"]]["ego"]
         if hand.in_intersection(ego):
-            assert "require (distance from ego to intersection) > 0" in r["failure"]
+            assert "require (distance from ego to intersection) > 0" in r["explanation"]
         else:
-            assert r["failure"].endswith("ego.heading")
+            assert r["explanation"].endswith("ego.heading")
             assert hand.follows_road(ego, -3, 3)
     assert sum(hand.in_intersection(hand.frames[f]["ego"]) for f in hand.frames) == 80
 

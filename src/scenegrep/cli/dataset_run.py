@@ -137,7 +137,7 @@ class RowPrinter:
     def _lines(self, row: dict[str, Any]) -> list[str]:
         explanation = (row["explanation"] or "").splitlines() if self.explain else []
         if row["status"] == "no match" and explanation:
-            return [f"{row['name']}  no match: {explanation[0]}", *(f"    {line}" for line in explanation[1:])]
+            return [f"{_place(row)}  no match: {explanation[0]}", *(f"    {line}" for line in explanation[1:])]
         if row["status"] != "match":
             return []
         return [match_line(row), *(f"    {line}" for line in explanation)]
@@ -146,7 +146,7 @@ class RowPrinter:
 def match_line(row: dict[str, Any]) -> str:
     """``NAME:START-END  object=id ...  |  variable=value ...  [holds] require ...`` for a match row."""
     pairs = "  ".join(f"{k}={v}" for k, v in json.loads(row["correspondence"] or "{}").items())
-    text = f"{row['name']}:{row['start_frame']}-{row['end_frame']}  {pairs}".rstrip()
+    text = f"{_place(row)}  {pairs}".rstrip()
     values = json.loads(row.get("values") or "{}")
     variables = {k: v for k, v in values.items() if not isinstance(v, bool)}
     if variables:
@@ -155,6 +155,12 @@ def match_line(row: dict[str, Any]) -> str:
     if soft:
         text += "  |  " + "  ".join(f"[{'holds' if ok else 'fails'}] {name}" for name, ok in soft.items())
     return text
+
+
+def _place(row: dict[str, Any]) -> str:
+    """``NAME:START-END`` (dataset frame indices of the first and last frame), or ``NAME`` for a
+    row without frames."""
+    return row["name"] if row.get("start_frame") is None else f"{row['name']}:{row['start_frame']}-{row['end_frame']}"
 
 
 def _value_text(value: Any) -> str:

@@ -15,9 +15,11 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+import pyarrow as pa
+
 from .. import readers
-from ..errors import failure_text
-from ..model import LabelTrace
+from ..errors import UserError, at, failure_text
+from ..model import LabelTrace, RoadMap
 from .ingest import Source, catalog_row, discover, prepare_trace, trace_id_of
 from .plan import Needs, needs_of, prune_reason
 from .queries import ORDER, QuerySpec, compiled, match_trace, pruned_row, query_trace, results_table
@@ -32,16 +34,26 @@ def query_files(
     paths: list[str], spec: QuerySpec, map_path: str | None = None, on_rows: RowsCallback | None = None
 ) -> Results:
     """Run ``spec`` over every trace under ``paths``; ``map_path`` is the road map of traces
-    without their own. ``on_rows`` sees each trace's rows (a failed path's or source's row) as
-    soon as they are ready. The results are ordered as a dataset run's, with its run id."""
+    without their own. ``on_rows`` sees each trace's rows (a failed path's or source's row), with
+    every column, as soon as they are ready. The results are ordered as a dataset run's, with its run id."""
     needs = needs_of(spec, compiled(spec))
     sources, bad = discover(paths)
-    rows: list[dict[str, Any]] = []
+    tables = []
     for batch in _batches(spec, needs, sources, bad, map_path):
-        rows.extend(batch)
+        tables.append(results_table(batch))
         if on_rows is not None:
-            on_rows(batch)
-    return Results(results_table(rows).sort_by(ORDER), run_id_of(spec))
+            on_rows(tables[-1].to_pylist())
+    table = pa.concat_tables([results_table([]), *tables]).sort_by(ORDER)
+    return Results(table, run_id_of(spec), query=spec.key())
+
+
+def read_queried_trace(source: str, trace_id: str) -> tuple[LabelTrace, RoadMap | None]:
+    """The trace ``trace_id`` of a query over files and its own road map, read from its
+    ``source`` as the query read it (UserError if the source no longer holds it)."""
+    for number, trace in enumerate(readers.read_traces(source)):
+        if trace_id_of(source, trace.name, number) == trace_id:
+            return prepare_trace(trace, label=True)
+    raise UserError(f"holds no trace {trace_id!r} (changed since the query?)", at(source))
 
 
 def _batches(

@@ -17,7 +17,7 @@ from __future__ import annotations
 import hashlib
 import os
 import re
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -82,7 +82,9 @@ class IngestReport:
 
 
 def discover(paths: list[str]) -> tuple[list[Source], list[tuple[str, str]]]:
-    """The sources under ``paths`` and the given paths that are not inputs (path, error).
+    """The sources under ``paths`` and the paths that are not inputs or cannot be read (path,
+    error): a given path, or a file in a searched directory that looks like an input but is
+    unreadable (a truncated Parquet file); the other files are still found.
 
     Directories that are not inputs are searched recursively; files found there that are not
     trace inputs (READMEs, manifests, map-only files) are skipped silently, and so are JSON files
@@ -90,33 +92,39 @@ def discover(paths: list[str]) -> tuple[list[Source], list[tuple[str, str]]]:
     sources: list[Source] = []
     errors: list[tuple[str, str]] = []
     for path in paths:
-        try:
-            sources.extend(_sources_in(Path(path), explicit=True))
-        except UserError as exc:
-            errors.append((str(Path(path).resolve()), exc.one_line()))
+        _collect(Path(path), True, sources, errors)
     unique = {s.path: s for s in sources}
     return list(unique.values()), errors
 
 
-def _sources_in(path: Path, explicit: bool) -> Iterator[Source]:
-    if path.is_dir():
-        found = _directory_format(path)
-        if found is not None:
-            yield Source(str(path.resolve()), found)
+def _collect(path: Path, explicit: bool, sources: list[Source], errors: list[tuple[str, str]]) -> None:
+    """Add the sources at ``path`` (a given path when ``explicit``, else one found in a directory)."""
+    try:
+        if path.is_dir():
+            found = _directory_format(path)
+            if found is not None:
+                sources.append(Source(str(path.resolve()), found))
+                return
+            for child in sorted(path.iterdir()):
+                if not child.name.startswith("."):
+                    _collect(child, False, sources, errors)
             return
-        for child in sorted(path.iterdir()):
-            if not child.name.startswith("."):
-                yield from _sources_in(child, explicit=False)
-        return
+        name = _file_format(path, explicit)
+        if name is not None:
+            sources.append(Source(str(path.resolve()), name))
+    except UserError as exc:
+        errors.append((str(path.resolve()), exc.one_line()))
+
+
+def _file_format(path: Path, explicit: bool) -> str | None:
+    """The trace format of a file: a given file must be one; a found one is skipped (None) if not."""
     if explicit:
         name = readers.detect_format(path)
         if not readers.FORMATS[name].traces:
             raise UserError(f"a {readers.FORMATS[name].description} holds no label trace", at(path))
-        yield Source(str(path.resolve()), name)
-        return
+        return name
     name = readers.sniff_file(path)
-    if name is not None and name not in SKIPPED and readers.FORMATS[name].traces:
-        yield Source(str(path.resolve()), name)
+    return name if name is not None and name not in SKIPPED and readers.FORMATS[name].traces else None
 
 
 def _directory_format(path: Path) -> str | None:

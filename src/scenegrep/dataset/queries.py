@@ -1,7 +1,8 @@
 """The three query kinds as the dataset engine sees them: a picklable :class:`QuerySpec`,
 compiled once per process, applied to one trace to give rows of the results table.
 
-Results table (one row per match; a trace without a match has one row with ``match`` -1):
+Results table (one row per match; a trace without a match has one row with ``match`` -1; a
+scene query with ``explain`` has a 'no match' row for each frame that does not match, saying why):
 ``trace_id``, ``name`` (the trace's name), ``source`` (the ingested input), ``status``
 ('match', 'no match', 'pruned' or 'failed'), ``match`` (0, 1, ... within the trace),
 ``correspondence`` (JSON object: program object -> trace object id; for SpRE, the track
@@ -50,7 +51,7 @@ RESULTS_SCHEMA = pa.schema(
     ]
 )
 
-ORDER = [("trace_id", "ascending"), ("match", "ascending")]
+ORDER = [("trace_id", "ascending"), ("match", "ascending"), ("start_frame", "ascending")]
 """The order of a results table's rows."""
 
 OPTIONS: dict[str, dict[str, Any]] = {
@@ -173,10 +174,19 @@ def match_trace(spec: QuerySpec, trace: LabelTrace, road_map: RoadMap | None) ->
 
 
 def _window(trace: LabelTrace, match: int, first: int, last: int, correspondence: Any) -> dict[str, Any]:
+    """A match row: frames at positions first..last (inclusive) of ``trace``."""
     return {
         "status": "match",
         "match": match,
         "correspondence": json.dumps(correspondence or {}, sort_keys=True),
+        **_span(trace, first, last),
+    }
+
+
+def _span(trace: LabelTrace, first: int, last: int) -> dict[str, Any]:
+    """The frame-range columns of frames at positions first..last (inclusive): their dataset
+    frame indices and their times (s)."""
+    return {
         "start_frame": int(trace.frame_index[first]),
         "end_frame": int(trace.frame_index[last]),
         "start_time": float(trace.frame_time[first]),
@@ -209,9 +219,11 @@ def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMa
             soft = {name: bool(holds[number]) for name, holds in result.soft.items()}
             row["values"] = json.dumps(result.values(frame) | soft, allow_nan=True)
         rows.append(row)
-    if not rows and spec.option("explain"):
-        failures = (f"frame {int(trace.frame_index[f])}: {result.failure(f)}" for f in range(trace.n_frames))
-        return [{"status": "no match", "match": -1, "explanation": "\n".join(failures)}]
+    if spec.option("explain"):
+        rows.extend(
+            {"status": "no match", "match": -1, **_span(trace, f, f), "explanation": result.failure(f)}
+            for f in (~result.matched).nonzero()[0].tolist()
+        )
     return rows
 
 
@@ -244,9 +256,7 @@ def scenario_rows(result: Any, find_all: bool, explain: bool) -> list[dict[str, 
     return rows
 
 
-def query_trace(
-    identity: dict[str, Any], where: str, rows: Callable[[], list[dict[str, Any]]]
-) -> list[dict[str, Any]]:
+def query_trace(identity: dict[str, Any], where: str, rows: Callable[[], list[dict[str, Any]]]) -> list[dict[str, Any]]:
     """One trace's result rows, each with the trace's ``identity`` (trace_id, name, source,
     time_origin_ns): ``rows()`` loads and queries the trace; if it raises, the trace gets one
     'failed' row whose error names ``where``, and the caller goes on with the next trace."""

@@ -21,17 +21,20 @@ RESULTS_FILE = "results.parquet"
 
 RUN_ID_KEY = b"scenegrep.run_id"
 STATUS_KEY = b"scenegrep.status"
-"""Keys of the run's id and status in a results Parquet file's metadata."""
+QUERY_KEY = b"scenegrep.query"
+"""Keys of the run's id, status and query in a results Parquet file's metadata."""
 
 
 @dataclass(frozen=True)
 class Results:
-    """The results of a run: the table, the run's id and its ``status`` ('finished' or
-    'interrupted': then only the traces done so far have rows besides the pruned ones)."""
+    """The results of a run: the table, the run's id, its ``status`` ('finished' or
+    'interrupted': then only the traces done so far have rows besides the pruned ones) and its
+    ``query`` (:meth:`QuerySpec.key <scenegrep.dataset.queries.QuerySpec.key>`; "" when unknown)."""
 
     table: pa.Table
     run_id: str = ""
     status: str = "finished"
+    query: str = ""
 
     @classmethod
     def read(cls, path: str | Path) -> Results:
@@ -59,7 +62,8 @@ class Results:
         metadata = table.schema.metadata or {}
         run_id = metadata.get(RUN_ID_KEY, b"").decode() or (path.parent.name if path.name == RESULTS_FILE else "")
         status = metadata.get(STATUS_KEY, b"finished").decode()
-        return cls(table.select(RESULTS_SCHEMA.names).cast(RESULTS_SCHEMA), run_id, status)
+        query = metadata.get(QUERY_KEY, b"").decode()
+        return cls(table.select(RESULTS_SCHEMA.names).cast(RESULTS_SCHEMA), run_id, status, query)
 
     def __len__(self) -> int:
         return self.table.num_rows
@@ -116,7 +120,11 @@ class Results:
         from ..writers.atomic import atomic_path
 
         with atomic_path(path) as tmp:
-            metadata = {RUN_ID_KEY: self.run_id.encode(), STATUS_KEY: self.status.encode()}
+            metadata = {
+                RUN_ID_KEY: self.run_id.encode(),
+                STATUS_KEY: self.status.encode(),
+                QUERY_KEY: self.query.encode(),
+            }
             pq.write_table(self.table.replace_schema_metadata(metadata), tmp, compression="zstd")
 
 

@@ -74,7 +74,7 @@ def run_query(
     done = _finished_traces(parts)
     todo = [_task(root, row, maps) for row in planned.kept if row["trace_id"] not in done]
     status = _execute(spec, todo, parts, options, len(planned.kept), len(done))
-    return _finish(root, run_id, status, parts, planned)
+    return _finish(root, spec, status, parts, planned)
 
 
 def identity_of(row: dict[str, Any]) -> dict[str, Any]:
@@ -136,12 +136,13 @@ def _execute(spec: QuerySpec, todo: list[TraceTask], parts: Path, options: RunOp
     return "finished"
 
 
-def _finish(root: Path, run_id: str, status: str, parts: Path, planned: Plan) -> Results:
+def _finish(root: Path, spec: QuerySpec, status: str, parts: Path, planned: Plan) -> Results:
     """Gather the parts and the pruned traces into the results; write them out and to the catalog."""
     tables = [pq.read_table(p) for p in sorted(parts.glob("*.parquet"))]
     pruned = [{**identity_of(row), **pruned_row(reason)} for row, reason in planned.pruned]
     table = pa.concat_tables([results_table(pruned), *tables]).sort_by(ORDER)
-    results = Results(table, run_id, status)
+    run_id = run_id_of(spec)
+    results = Results(table, run_id, status, spec.key())
     results.write_parquet(root / "runs" / run_id / RESULTS_FILE)
     with Catalog(root) as catalog:
         catalog.finish_run(run_id, status, table, results.counts())

@@ -15,7 +15,6 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
-from ..dataset.catalog import Catalog
 from ..writers.atomic import atomic_path
 from .charts import bar_chart, histogram
 from .page import asset, html_page, view_page
@@ -51,7 +50,7 @@ def report_page(source: ResultsSource, link: Callable[[str, int], str]) -> str:
     """The report's HTML; ``link(trace_id, match_number)`` is the address of a match's view."""
     rows = source.results.table.to_pylist()
     matches = [r for r in rows if r["status"] == "match"]
-    kinds = _object_kinds(source.root, {r["trace_id"] for r in rows})
+    kinds = source.object_kinds({r["trace_id"] for r in rows})
     query = source.query
     body = asset("report.html").format(
         query=html.escape(f"{query.kind}: {query.text}" if query else "(query unknown)"),
@@ -64,22 +63,13 @@ def report_page(source: ResultsSource, link: Callable[[str, int], str]) -> str:
     return html_page(f"scenegrep report · {source.results.run_id or 'results'}", asset("report.css"), body)
 
 
-def _object_kinds(root: Path, trace_ids: set[str]) -> dict[tuple[str, str], str]:
-    """(trace_id, object_id) -> kind, for the given traces."""
-    with Catalog(root, read_only=True) as catalog:
-        found = catalog.rows(
-            "SELECT trace_id, object_id, kind FROM objects WHERE list_contains(?, trace_id)", [sorted(trace_ids)]
-        )
-    return {(t, o): k for t, o, k in found}
-
-
 def _summary(source: ResultsSource, matches: list[dict[str, Any]]) -> str:
     counts = source.results.counts()
     cards = [
         ("traces", counts["traces"]),
         ("matched", counts["matched"]),
         ("matches", len(matches)),
-        ("no match", source.results.traces_with("no match")),
+        ("no match", counts["traces"] - counts["matched"] - counts["pruned"] - counts["failed"]),
         ("pruned", counts["pruned"]),
         ("failed", counts["failed"]),
     ]

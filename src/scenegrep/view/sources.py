@@ -3,7 +3,9 @@
 A results table names traces by ``trace_id``; their Parquet files and road maps are found in
 the dataset's catalog. The dataset is the one given, or the one the results file lies in
 (``DATASET/runs/<run_id>/results.parquet``). The query behind the results (for the query text
-and a SpRE's classes) is the catalog's run of the table's ``run_id``.
+and a SpRE's classes) is the catalog's run of the table's ``run_id``. Results of a query over
+files (not inside a dataset) name the file each trace came from (``source``): the trace is read
+from it as the query read it, and the query is the one the results file records.
 """
 
 from __future__ import annotations
@@ -32,26 +34,27 @@ def find_dataset(path: str | Path) -> Path | None:
 
 @dataclass(frozen=True)
 class ResultsSource:
-    """A results table with the dataset that holds its traces (``root``) and its query."""
+    """A results table with the dataset that holds its traces (``root``; None: each trace is read
+    from its source file) and its query."""
 
     results: Results
-    root: Path
+    root: Path | None
     query: QueryInfo | None
 
     @classmethod
     def open(cls, path: str | Path, dataset: str | Path | None = None) -> ResultsSource:
-        """The results at ``path`` (a run directory, Parquet, JSON lines or CSV) and their dataset (UserError if
-        none is given and the file does not lie in one)."""
+        """The results at ``path`` (a run directory, Parquet, JSON lines or CSV) and their dataset: the
+        one given, else the one the file lies in, else none (a query over files)."""
         results = Results.read(path)
         root = Path(dataset).resolve() if dataset is not None else find_dataset(path)
         if root is None:
-            raise UserError("the results are not inside a dataset; name it with --dataset DATASET", at(path))
-        return cls(results, root, query_of(root, results.run_id))
+            return cls(results, None, recorded_query(results.query))
+        return cls.of_run(root, results)
 
     @classmethod
     def of_run(cls, root: Path, results: Results) -> ResultsSource:
         """A run's results over the dataset at ``root``."""
-        return cls(results, root, query_of(root, results.run_id))
+        return cls(results, root, query_of(root, results.run_id) or recorded_query(results.query))
 
     def trace_ids(self) -> list[str]:
         """The traces of the table, in its order, each once."""
@@ -63,8 +66,38 @@ class ResultsSource:
 
     def view(self, trace_id: str) -> TraceView:
         """The view of one trace of the table with its rows."""
-        trace, road_map = load_trace(self.root, trace_id)
+        trace, road_map = self.load(trace_id)
         return build_view(trace, road_map, self.rows_of(trace_id), self.query, trace_id)
+
+    def load(self, trace_id: str) -> tuple[Any, Any]:
+        """One trace of the table and its road map, from the dataset or from its source file."""
+        if self.root is not None:
+            return load_trace(self.root, trace_id)
+        from ..dataset.files import read_queried_trace
+
+        rows = self.rows_of(trace_id)
+        if not rows:
+            raise UserError(f"the results have no trace {trace_id!r}")
+        return read_queried_trace(rows[0]["source"], trace_id)
+
+    def object_kinds(self, trace_ids: set[str]) -> dict[tuple[str, str], str]:
+        """(trace_id, object_id) -> canonical kind, for the given traces."""
+        if self.root is not None:
+            with Catalog(self.root, read_only=True) as catalog:
+                found = catalog.rows(
+                    "SELECT trace_id, object_id, kind FROM objects WHERE list_contains(?, trace_id)",
+                    [sorted(trace_ids)],
+                )
+            return {(t, o): k for t, o, k in found}
+        from ..dataset.statistics import TraceStatistics
+
+        kinds = {}
+        for trace_id in trace_ids:
+            objects = TraceStatistics.of(self.load(trace_id)[0]).objects
+            kinds.update(
+                {(trace_id, o): k for o, k in zip(objects["object_id"].to_pylist(), objects["kind"].to_pylist())}
+            )
+        return kinds
 
     def matched_trace_ids(self) -> list[str]:
         """The traces with a match, in table order."""
@@ -90,6 +123,14 @@ def query_of(root: Path, run_id: str) -> QueryInfo | None:
         return None
     kind, text, options = found[0]
     return QueryInfo(kind, text, json.loads(options or "{}"))
+
+
+def recorded_query(key: str) -> QueryInfo | None:
+    """The query a results file records (:meth:`QuerySpec.key`), or None."""
+    if not key:
+        return None
+    kind, text, options = json.loads(key)
+    return QueryInfo(kind, text, options)
 
 
 def load_trace(root: Path, trace_id: str) -> tuple[Any, Any]:

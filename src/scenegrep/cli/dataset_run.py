@@ -17,6 +17,8 @@ import argparse
 import json
 import sys
 from collections import Counter
+from functools import partial
+from pathlib import Path
 from typing import Any
 
 from .main import EXIT_INTERRUPTED, EXIT_SOME_FAILED
@@ -60,9 +62,11 @@ def run_query_command(
         results, where = _over_files(args, spec, paths, printer), ""
     if args.output:
         results.write_parquet(args.output)
+    counts = results.counts()
     if not args.quiet:
         _summary(results, where or (f"; results in {args.output}" if args.output else ""))
-    counts = results.counts()
+        if kind != "spre" and not counts["matched"]:
+            _nearest_misses(spec, results, args)
     if results.status == "interrupted":
         return EXIT_INTERRUPTED
     if counts["failed"]:
@@ -81,8 +85,6 @@ def _over_files(args: argparse.Namespace, spec: Any, paths: list[str], printer: 
 
 
 def _over_dataset(args: argparse.Namespace, spec: Any, paths: list[str], printer: RowPrinter) -> tuple[Any, str]:
-    from pathlib import Path
-
     from ..dataset.run import RunOptions, run_query
     from ..errors import UserError
 
@@ -169,6 +171,30 @@ def _value_text(value: Any) -> str:
     if isinstance(value, list):
         return "(" + ", ".join("?" if c is None else f"{c:.6g}" for c in value) + ")"
     return "?" if value is None else str(value)
+
+
+def _nearest_misses(spec: Any, results: Any, args: argparse.Namespace) -> None:
+    """The nearest misses of a Scenic query that matched nothing (:mod:`scenegrep.dataset.misses`):
+    its first traces without a match, read again from the dataset or from their files."""
+    from ..dataset.misses import nearest_misses
+    from .misses import print_misses, what_of
+
+    rows = results.table.to_pylist()
+    load = partial(_dataset_trace, Path(args.dataset).resolve()) if args.dataset else partial(_file_trace, rows, args)
+    print_misses(nearest_misses(spec, rows, load), what_of(spec.kind), args.json)
+
+
+def _dataset_trace(root: Path, trace_id: str) -> tuple[Any, Any]:
+    from ..view.sources import load_trace
+
+    return load_trace(root, trace_id)
+
+
+def _file_trace(rows: list[dict[str, Any]], args: argparse.Namespace, trace_id: str) -> tuple[Any, Any]:
+    from ..dataset.files import read_queried_trace
+
+    (source,) = {row["source"] for row in rows if row["trace_id"] == trace_id}
+    return read_queried_trace(source, trace_id, getattr(args, "map", None))
 
 
 def _report_plan(plan: Any) -> None:

@@ -47,12 +47,15 @@ def query_files(
     return Results(table, run_id_of(spec), query=spec.key())
 
 
-def read_queried_trace(source: str, trace_id: str) -> tuple[LabelTrace, RoadMap | None]:
-    """The trace ``trace_id`` of a query over files and its own road map, read from its
-    ``source`` as the query read it (UserError if the source no longer holds it)."""
+def read_queried_trace(source: str, trace_id: str, map_path: str | None = None) -> tuple[LabelTrace, RoadMap | None]:
+    """The trace ``trace_id`` of a query over files and its road map (its own, else ``map_path``'s),
+    read from its ``source`` as the query read it (UserError if the source no longer holds it)."""
     for number, trace in enumerate(readers.read_traces(source)):
         if trace_id_of(source, trace.name, number) == trace_id:
-            return prepare_trace(trace, label=True)
+            prepared, road_map = prepare_trace(trace, label=True)
+            if road_map is None and map_path:
+                road_map = readers.read_map(map_path)
+            return prepared, road_map
     raise UserError(f"holds no trace {trace_id!r} (changed since the query?)", at(source))
 
 

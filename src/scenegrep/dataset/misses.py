@@ -12,7 +12,7 @@ import numpy as np
 from ..errors import UserError
 from ..model import LabelTrace, RoadMap
 from ..scene.misses import MissLimits, NearestMisses
-from .queries import QuerySpec, compiled, spec_tolerance
+from .queries import QuerySpec, compiled, scenario_options, scene_options
 
 Loader = Callable[[str], tuple[LabelTrace, RoadMap | None]]
 """A trace of the run and its road map, by trace id."""
@@ -23,14 +23,8 @@ def scene_result(spec: QuerySpec, trace: LabelTrace, road_map: RoadMap | None) -
     frame positions to search (None: all)."""
     query = compiled(spec)
     if spec.kind == "scene":
-        from ..scene import SceneOptions
-
-        options = SceneOptions(spec_tolerance(spec), spec.option("exact"), spec.option("visible_distance"))
-        return query.match(trace, road_map, options), None
-    from ..scenario import ScenarioOptions
-
-    options = ScenarioOptions(spec_tolerance(spec), spec.option("visible_distance"))
-    return query.initial_scene(trace, spec.option("window"), road_map, options)
+        return query.match(trace, road_map, scene_options(spec)), None
+    return query.initial_scene(trace, spec.option("window"), road_map, scenario_options(spec))
 
 
 def nearest_misses(

@@ -207,11 +207,22 @@ def _spre_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap
     return rows
 
 
-def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
+def scene_options(spec: QuerySpec) -> Any:
+    """The :class:`~scenegrep.scene.SceneOptions` of a scene spec."""
     from ..scene import SceneOptions
 
-    options = SceneOptions(spec_tolerance(spec), spec.option("exact"), spec.option("visible_distance"))
-    result = query.match(trace, road_map, options)
+    return SceneOptions(spec_tolerance(spec), spec.option("exact"), spec.option("visible_distance"))
+
+
+def scenario_options(spec: QuerySpec) -> Any:
+    """The :class:`~scenegrep.scenario.ScenarioOptions` of a scenario spec."""
+    from ..scenario import ScenarioOptions
+
+    return ScenarioOptions(spec_tolerance(spec), spec.option("visible_distance"), spec.option("all"))
+
+
+def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
+    result = query.match(trace, road_map, scene_options(spec))
     rows = []
     for number, frame in enumerate(result.frames().tolist()):
         row = _window(trace, number, frame, frame, result.correspondence(frame))
@@ -228,14 +239,11 @@ def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMa
 
 
 def _scenario_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
-    from ..scenario import ScenarioOptions
-
     if trace.behaviours is None:
         from ..label import label_trace
 
         trace = label_trace(trace, road_map).trace
-    options = ScenarioOptions(spec_tolerance(spec), spec.option("visible_distance"), spec.option("all"))
-    result = query.match(trace, spec.option("window"), road_map, options)
+    result = query.match(trace, spec.option("window"), road_map, scenario_options(spec))
     return scenario_rows(result, spec.option("all"), spec.option("explain"))
 
 

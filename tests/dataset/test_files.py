@@ -1,0 +1,182 @@
+"""One execution path: a query over files runs the dataset engine's per-trace path and gives the
+results table a dataset run gives; one bad file or trace fails alone (exit 3); one frame-range
+convention in every output; the table a query over files writes opens in show, report, export."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import shutil
+import time
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from scenegrep.cli.main import main
+from scenegrep.dataset.results import Results
+from scenegrep.readers.trace_json import read_trace as read_json_trace
+from scenegrep.writers.trace_json import write_trace_json
+from scenegrep.writers.trace_parquet import write_map_parquet
+from tests.conftest import REPO
+from tests.scenario.worked_example import worked_map, worked_trace
+
+from .conftest import SAMPLE
+
+QUERIES = {
+    "scene": [
+        "scene",
+        "examples/scenes/fig3_car_ahead.scenic",
+        "--tolerance-position",
+        "0.5",
+        "--tolerance-heading",
+        "0.1",
+    ],
+    "scenario": ["scenario", "examples/queries/s1_lane_change_stationary_car.scenic", "--window", "75"],
+    "spre": ["spre", "[[:pedestrian:]][[:bicycle:]]"],
+}
+FIG1 = "examples/queries/fig1_lane_change.scenic"
+
+
+def run(argv: list, capsys) -> tuple[int, list[str], list[str]]:
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out.splitlines(), err.splitlines()
+
+
+@pytest.mark.slow
+@pytest.mark.real_data
+@pytest.mark.parametrize("kind", list(QUERIES))
+def test_files_and_dataset_give_the_same_results_table(kind, real_data, real_dataset, tmp_path, capsys, monkeypatch):
+    """Over all of ../shared/real_data and examples/sample: equal tables (rows, columns, trace ids,
+    statuses, pruning reasons, windows, correspondences), with matches, in both modes."""
+    monkeypatch.chdir(REPO)
+    files, dataset = tmp_path / "files.parquet", tmp_path / "dataset.parquet"
+    started = time.perf_counter()
+    command, query, *options = QUERIES[kind]
+    over_files = main([command, query, str(real_data), str(SAMPLE), *options, "--output", str(files), "-q"])
+    middle = time.perf_counter()
+    over_dataset = main([*QUERIES[kind], "--dataset", str(real_dataset), "--output", str(dataset), "-q"])
+    ended = time.perf_counter()
+    a, b = Results.read(files), Results.read(dataset)
+    assert over_files == over_dataset == 0
+    assert a.table.column_names == b.table.column_names
+    assert a.table.to_pylist() == b.table.to_pylist()
+    assert a.run_id == b.run_id and a.query == b.query
+    counts = a.counts()
+    assert counts["traces"] == 62 and counts["matched"] > 0 and counts["failed"] == 0
+    print(f"{kind}: {a.table.num_rows} rows, {counts}; files {middle - started:.1f} s, dataset {ended - middle:.1f} s")
+
+
+@pytest.fixture
+def folder(tmp_path: Path) -> Path:
+    """Three sample traces with their map beside them (as in examples/), a truncated trace file and
+    a file of garbage among them."""
+    shutil.copytree(REPO / "examples" / "maps", tmp_path / "maps")
+    traces = tmp_path / "traces"
+    traces.mkdir()
+    for number in (0, 1, 3):
+        shutil.copy(SAMPLE / f"fig1_lane_change-00{number}.parquet", traces)
+    (traces / "fig1_lane_change-002.parquet").write_bytes((SAMPLE / "fig1_lane_change-002.parquet").read_bytes()[:3000])
+    (traces / "zz.parquet").write_bytes(b"garbage")
+    return traces
+
+
+def test_a_bad_file_in_a_folder_fails_alone(folder, capsys):
+    code, lines, err = run(
+        ["scenario", "examples/queries/s1_lane_change_stationary_car.scenic", folder, "--window", "75"], capsys
+    )
+    assert code == 3
+    assert [line.split(":")[0] for line in lines] == [f"fig1_lane_change-00{n}" for n in (0, 1, 3)]
+    failed = [line for line in err if line.startswith("scenegrep: failed: ")]
+    assert len(failed) == 2 and "fig1_lane_change-002.parquet" in failed[0] and "zz.parquet" in failed[1]
+    assert "truncated or corrupt" in failed[0] and not any("Traceback" in line for line in err)
+    assert err[-1] == "scenegrep: 3 of 5 traces match, 0 pruned, 2 failed"
+
+
+def test_a_trace_whose_query_raises_fails_alone(folder, capsys, monkeypatch):
+    """A bug while querying one trace (here: an exception planted in the scene matcher for one
+    trace) fails that trace, with its type and message, and the later traces still run."""
+    from scenegrep.scene.query import SceneQuery
+
+    original = SceneQuery.match
+
+    def match(self, trace, *args, **kwargs):
+        if trace.name == "fig1_lane_change-001":
+            raise RecursionError("planted")
+        return original(self, trace, *args, **kwargs)
+
+    monkeypatch.setattr(SceneQuery, "match", match)
+    (folder / "fig1_lane_change-002.parquet").unlink()
+    (folder / "zz.parquet").unlink()
+    code, lines, err = run(["scene", "examples/scenes/fig3_car_ahead.scenic", folder, "--json"], capsys)
+    rows = [json.loads(line) for line in lines]
+    statuses = {r["name"]: r["status"] for r in rows}
+    assert code == 3 and set(statuses) == {f"fig1_lane_change-00{n}" for n in (0, 1, 3)}
+    assert statuses["fig1_lane_change-001"] == "failed"
+    (failed,) = [r for r in rows if r["status"] == "failed"]
+    assert failed["error"].endswith("fig1_lane_change-001.parquet: RecursionError: planted")
+    assert any(line == f"scenegrep: failed: fig1_lane_change-001: {failed['error']}" for line in err)
+
+
+@pytest.fixture
+def shifted(tmp_path: Path) -> Path:
+    """Seed 000's Table 2 trace without its first frame (frame indices 1..4 at 0.5..2 s, at
+    positions 0..3), and its map."""
+    trace = worked_trace()
+    write_trace_json(trace.slice_frames(1, trace.n_frames), tmp_path / "shifted.json")
+    write_map_parquet(worked_map(), tmp_path / "map.parquet")
+    assert read_json_trace(tmp_path / "shifted.json").frame_index.tolist() == [1, 2, 3, 4]
+    return tmp_path
+
+
+def test_one_frame_convention_in_every_output(shifted, capsys):
+    """``start_frame``/``end_frame`` are the dataset's frame indices of the first and last frame,
+    ``start_time``/``end_time`` their times, in text, JSON, CSV and Parquet alike; a STREM stream's
+    frames 10 and 20 are 10-20 (STREM's own 10..21 only with --compat strem)."""
+    base = [FIG1, shifted / "shifted.json", "--window", "3", "--map", shifted / "map.parquet", "--all"]
+    out = shifted / "out.parquet"
+    code, text, _ = run(["scenario", *base, "--output", out], capsys)
+    assert code == 0 and [line.split("  ")[0] for line in text] == ["table2:1-3", "table2:2-4"]
+    expected = [(1, 3, 0.5, 1.5), (2, 4, 1.0, 2.0)]
+    spans = lambda rows: [
+        (int(r["start_frame"]), int(r["end_frame"]), float(r["start_time"]), float(r["end_time"])) for r in rows
+    ]  # noqa: E731
+    assert spans(pq.read_table(out).to_pylist()) == expected
+    assert spans(map(json.loads, run(["scenario", *base, "--json"], capsys)[1])) == expected
+    assert spans(csv.DictReader(io.StringIO("\n".join(run(["scenario", *base, "--csv"], capsys)[1])))) == expected
+    stream = REPO.parent / "shared" / "conformance" / "strem" / "data" / "noncontig.json"
+    if stream.is_file():
+        assert run(["spre", "[[:car:]]{2}", stream], capsys)[1] == ["noncontig:10-20"]
+        (row,) = map(json.loads, run(["spre", "--json", "[[:car:]]{2}", stream], capsys)[1])
+        assert (row["start_frame"], row["end_frame"]) == (10, 20)
+        assert run(["spre", "--compat", "strem", "[[:car:]]{2}", stream], capsys)[1] == [f"{stream}:10..21"]
+
+
+def test_results_of_a_query_over_files_open_in_show_report_and_export(folder, tmp_path, capsys, monkeypatch):
+    """--output, --json and --csv of a query over files (no dataset) are read by show, report
+    and export; the traces are read again from their files, the query from the Parquet file."""
+    monkeypatch.chdir(REPO)
+    for name in ("fig1_lane_change-002.parquet", "zz.parquet"):
+        (folder / name).unlink()
+    base = ["scenario", "examples/queries/s1_lane_change_stationary_car.scenic", str(folder), "--window", "75"]
+    results = tmp_path / "results.parquet"
+    assert main([*map(str, base), "--output", str(results), "-q"]) == 0
+    for option, suffix in (("--json", ".json"), ("--csv", ".csv")):
+        code, lines, _ = run([*base, option], capsys)
+        assert code == 0
+        (tmp_path / f"results{suffix}").write_text("".join(line + "\n" for line in lines))
+        again = Results.read(tmp_path / f"results{suffix}")
+        assert again.table.to_pylist() == Results.read(results).table.to_pylist()
+        assert (
+            main(["show", str(tmp_path / f"results{suffix}"), "--match", "1", "-o", str(tmp_path / "m.png"), "-q"]) == 0
+        )
+    assert main(["show", str(results), "--match", "2", "-o", str(tmp_path / "m.html"), "-q"]) == 0
+    page = (tmp_path / "m.html").read_text()
+    assert "fig1_lane_change-003" in page and "parkedCar" in page
+    assert main(["report", str(results), "-o", str(tmp_path / "report.html")]) == 0
+    report = (tmp_path / "report.html").read_text()
+    assert 'data-count="matches"><b>3</b>' in report and "parkedCar" in report
+    assert main(["export", str(results), "--mcap", str(tmp_path / "m.mcap"), "-q"]) == 0
+    assert (tmp_path / "m.mcap").stat().st_size > 0

@@ -120,6 +120,11 @@ def test_a_trace_whose_query_raises_fails_alone(folder, capsys, monkeypatch):
     assert any(line == f"scenegrep: failed: fig1_lane_change-001: {failed['error']}" for line in err)
 
 
+def _spans(rows) -> list[tuple[int, int, float, float]]:
+    """The frame-range columns of result rows (as text from CSV, or typed)."""
+    return [(int(r["start_frame"]), int(r["end_frame"]), float(r["start_time"]), float(r["end_time"])) for r in rows]
+
+
 @pytest.fixture
 def shifted(tmp_path: Path) -> Path:
     """Seed 000's Table 2 trace without its first frame (frame indices 1..4 at 0.5..2 s, at
@@ -140,12 +145,9 @@ def test_one_frame_convention_in_every_output(shifted, capsys):
     code, text, _ = run(["scenario", *base, "--output", out], capsys)
     assert code == 0 and [line.split("  ")[0] for line in text] == ["table2:1-3", "table2:2-4"]
     expected = [(1, 3, 0.5, 1.5), (2, 4, 1.0, 2.0)]
-    spans = lambda rows: [
-        (int(r["start_frame"]), int(r["end_frame"]), float(r["start_time"]), float(r["end_time"])) for r in rows
-    ]  # noqa: E731
-    assert spans(pq.read_table(out).to_pylist()) == expected
-    assert spans(map(json.loads, run(["scenario", *base, "--json"], capsys)[1])) == expected
-    assert spans(csv.DictReader(io.StringIO("\n".join(run(["scenario", *base, "--csv"], capsys)[1])))) == expected
+    assert _spans(pq.read_table(out).to_pylist()) == expected
+    assert _spans(map(json.loads, run(["scenario", *base, "--json"], capsys)[1])) == expected
+    assert _spans(csv.DictReader(io.StringIO("\n".join(run(["scenario", *base, "--csv"], capsys)[1])))) == expected
     stream = REPO.parent / "shared" / "conformance" / "strem" / "data" / "noncontig.json"
     if stream.is_file():
         assert run(["spre", "[[:car:]]{2}", stream], capsys)[1] == ["noncontig:10-20"]

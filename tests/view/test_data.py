@@ -57,6 +57,8 @@ def test_a_trace_without_a_match_carries_the_explanation():
     trace = small_trace([[True, False, False]] * 2, ["car", "car", "bus"])
     view = build_view(trace, rows=[{"status": "no match", "match": -1, "explanation": "ego never brakes"}])
     assert view.matches == () and view.note == "no match: ego never brakes"
+    frames = [{"status": "no match", "match": -1, "start_frame": f, "explanation": f"gap {f}"} for f in (0, 1)]
+    assert build_view(trace, rows=frames).note == "no match at frame 0: gap 0\nno match at frame 1: gap 1"
 
 
 def test_spre_marks_observations_of_the_named_classes_with_their_filters():

@@ -92,7 +92,8 @@ def build_view(
         if row["status"] == "match":
             matches.append(_match_view(trace, positions, row))
         elif row.get("explanation") or row.get("error"):
-            notes.append(f"{row['status']}: {row.get('error') or row.get('explanation')}")
+            at = "" if row.get("start_frame") is None else f" at frame {row['start_frame']}"
+            notes.append(f"{row['status']}{at}: {row.get('error') or row.get('explanation')}")
     marked, marked_boxes = _marked(trace, query) if query is not None and query.kind == "spre" else (None, None)
     return TraceView(
         trace,

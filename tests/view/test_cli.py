@@ -81,11 +81,19 @@ def test_show_user_errors_are_one_line_and_exit_2(real_dataset, scenario_run, tm
     assert message in err and len(err.strip().splitlines()) == 1
 
 
-def test_results_outside_a_dataset_need_the_dataset_named(scenario_run, tmp_path, capsys):
+def test_results_outside_a_dataset_read_their_traces_from_their_sources(scenario_run, tmp_path, capsys):
+    """Outside a dataset (and without --dataset), each trace is read again from its source as the
+    query over files reads it; a source that is gone is a one-line error."""
+    import pyarrow as pa
+
     copy = tmp_path / "results.parquet"
     scenario_run.write_parquet(copy)
+    assert main(["show", str(copy), "-o", str(tmp_path / "x.html"), "-q"]) == 0
+    gone = scenario_run.table.set_column(2, "source", pa.array([str(tmp_path / "gone.parquet")] * len(scenario_run)))
+    Results(gone, scenario_run.run_id).write_parquet(copy)
     assert main(["show", str(copy), "-o", str(tmp_path / "x.html")]) == 2
-    assert "name it with --dataset DATASET" in capsys.readouterr().err
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith("scenegrep: error: ") and "gone.parquet" in line
 
 
 def test_report_links_every_match_to_a_written_view(real_dataset, spre_run, tmp_path, capsys):

@@ -50,7 +50,7 @@ def test_a_full_disk_is_one_line_exit_2_and_no_file(tmp_path, monkeypatch, capsy
     monkeypatch.setattr(pq, "write_table", _disk_full)
     out = tmp_path / "out" / "matches.parquet"
     program = REPO / "examples/scenes/fig3_car_ahead.scenic"
-    assert main(["scene", str(program), str(SAMPLE), "--parquet", str(out), "-q"]) == 2
+    assert main(["scene", str(program), str(SAMPLE), "--output", str(out), "-q"]) == 2
     err = capsys.readouterr().err
     assert err == f"scenegrep: error: {out}: cannot write: No space left on device\n"
     assert list(out.parent.iterdir()) == []

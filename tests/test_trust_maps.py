@@ -96,13 +96,13 @@ def test_the_planted_snet_runs_code_when_scenic_loads_it(tmp_path):
 
 def run(folder: Path, capsys, *args: str) -> tuple[int, list[str]]:
     """Run a command line inside ``folder`` (relative names resolve there): the exit code and
-    the error lines on stderr (notes and summaries left out)."""
+    the error lines on stderr, a failed trace's included (notes and summaries left out)."""
     with pytest.MonkeyPatch.context() as patch:
         patch.chdir(folder)
         code = main(list(args))
     err = capsys.readouterr().err.strip().splitlines()
     assert not any("Traceback" in line for line in err), err
-    return code, [line for line in err if line.startswith("scenegrep: error: ")]
+    return code, [line for line in err if line.startswith(("scenegrep: error: ", "scenegrep: failed: "))]
 
 
 @pytest.mark.parametrize("trace", ["snet.json", "bare.json"])

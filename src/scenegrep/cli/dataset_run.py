@@ -52,9 +52,12 @@ def run_query_command(
     args: argparse.Namespace, kind: str, query: str, origin: str, options: dict[str, Any], paths: list[str]
 ) -> int:
     """Run a query over ``paths`` or ``args.dataset``, print its results; returns the exit code."""
+    from .. import readers
     from ..dataset import QuerySpec
 
     spec = QuerySpec.of(kind, query, origin, **options)
+    if getattr(args, "map", None):
+        readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
     printer = RowPrinter(args)
     if args.dataset:
         results, where = _over_dataset(args, spec, paths, printer)

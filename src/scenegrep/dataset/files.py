@@ -1,8 +1,9 @@
 """A query over files: the dataset engine's per-trace path for traces that are not ingested.
 
 The sources under the given paths are found as ``ingest`` finds them
-(:func:`.ingest.discover`); each trace is read as ingest reads it (its own road map; labelled
-when it has no behaviour labels: :func:`.ingest.prepare_trace`), planned with the planner's SQL
+(:func:`.ingest.discover`); each trace is read as ingest reads it (:func:`.ingest.prepare_trace`:
+its own road map, unless the query reads no map (a SpRE); labelled with that map when it has no
+behaviour labels, for a scenario query, the only kind that reads labels), planned with the planner's SQL
 on a catalog in memory (:func:`.plan.prune_reason`), and queried by the engine's per-trace
 function (:func:`.queries.query_trace`). So its rows, trace ids included, equal those of the
 same query over a dataset that ingested the same paths. A path, source or trace that fails gives
@@ -22,7 +23,7 @@ from ..errors import UserError, at, failure_text
 from ..model import LabelTrace, RoadMap
 from .ingest import Source, catalog_row, discover, prepare_trace, trace_id_of
 from .plan import Needs, needs_of, prune_reason
-from .queries import ORDER, QuerySpec, compiled, match_trace, pruned_row, query_trace, results_table
+from .queries import ORDER, QuerySpec, compiled, match_trace, pruned_row, query_trace, results_table, uses_map
 from .results import Results
 from .run import run_id_of
 from .statistics import time_origin_ns
@@ -93,7 +94,7 @@ def _trace_rows(
     identity = {"trace_id": trace_id, "name": trace.name, "source": source, "time_origin_ns": time_origin_ns(trace)}
 
     def rows() -> list[dict[str, Any]]:
-        prepared, road_map = prepare_trace(trace, label=True)
+        prepared, road_map = prepare_trace(trace, label=spec.kind == "scenario") if uses_map(spec) else (trace, None)
         row, statistics = catalog_row(prepared, trace_id, source, "", None)
         reason = prune_reason(needs, row, statistics)
         if reason is not None:

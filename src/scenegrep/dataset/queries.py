@@ -312,8 +312,13 @@ def _task_rows(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> li
     from .. import readers
 
     trace = readers.read_trace(task.file, "scenegrep-parquet")
-    map_path = task.map_file or fallback_map
+    map_path = (task.map_file or fallback_map) if uses_map(spec) else None
     return match_trace(spec, trace, readers.read_map(map_path) if map_path else None)
+
+
+def uses_map(spec: QuerySpec) -> bool:
+    """Whether the query reads road maps (Scenic queries do; a SpRE never reads one)."""
+    return spec.kind != "spre"
 
 
 def results_table(rows: list[dict[str, Any]]) -> pa.Table:

@@ -10,20 +10,29 @@ object's heading is the field at the end. Headings are those of :mod:`.geometry`
 
 The field ``roadDirection`` is piecewise constant: a point takes the heading of one centreline
 segment of the lane (or intersection lane) holding it, or 0 off the lanes. The heading can only
-change where a point crosses the *linework*: a lane or intersection boundary, or, at each
-interior vertex of a centreline, its two segment normals and their bisector (where the nearest
-segment of a lane changes), each reaching across the lane. For a fixed step count and a fixed
-sequence of headings every point of the walk is affine in D, so the points of step k sweep a
-segment as D runs over an interval; cutting that segment where it crosses the linework gives
-sub-intervals of D on which h_k is constant (read at their midpoints). Doing this step by step
-partitions the D interval into *pieces* — D intervals with one heading sequence, hence one
-end ``X + D * a`` and one end heading — with at most one piece per crossing plus one per step
-count: the enumeration is exact and bounded, not a sample.
+change where a point crosses the *linework*: a lane or intersection boundary; at each interior
+vertex of a centreline, its two segment normals and their bisector (where the projection onto
+the centreline passes the vertex or jumps across the inner side), reaching 1 m beyond the lane;
+or, where a centreline turns by more than 90° within twice its reach (the lane's half width
+plus 1 m; folds where lane sections join, sharp bends), a point equally near two non-adjacent
+segments and nearer than the rest (roots of a difference of squared distances, piecewise
+quadratic in D). For a
+fixed step count and a fixed sequence of headings every point of the walk is affine in D, so
+the points of step k sweep a segment as D runs over an interval; cutting that segment where it
+crosses the linework gives sub-intervals of D on which h_k is constant (read at their
+midpoints). Doing this step by step partitions the D interval into *pieces* — D intervals with
+one heading sequence, hence one end ``X + D * a`` and one end heading — at most one piece per
+crossing plus one per step count: the enumeration is exact and bounded, not a sample. Given the
+box the end must reach (the label and its tolerance), a branch is dropped as soon as its
+remaining steps (each ``|D| / n`` long) cannot bring it there.
 
 Exact up to the boundaries between pieces (D values where a walk point lies on the linework,
-a finite set), with one assumption stated here: where a point lies in no lane but inside an
-intersection area, or (for the end heading) off every lane, the *nearest* lane's direction is
-read at the piece's midpoint, i.e. the nearest lane is assumed not to change inside a piece.
+a finite set), with two assumptions: non-adjacent centreline segments compete only across a
+turn of more than 90° (true when the centreline's radius of curvature exceeds the lane's half
+width; tests walk Town01 and Town06 at random against the step-by-step walk); and where a point
+lies in no lane but inside an intersection area, or (for the end heading) off every lane, the
+*nearest* lane's direction is read at the piece's midpoint, i.e. the nearest lane is assumed not
+to change inside a piece.
 """
 
 from __future__ import annotations

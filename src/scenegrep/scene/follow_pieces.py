@@ -77,6 +77,7 @@ class Linework:
     tree: shapely.STRtree
     pairs: np.ndarray
     pair_lane: np.ndarray
+    pair_reach: np.ndarray
     pair_tree: shapely.STRtree
     polylines: Polylines
 
@@ -125,7 +126,8 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     start, end = start[keep], end[keep]
     tree = shapely.STRtree(shapely.linestrings(np.stack([start, end], axis=1)))
     pairs, lanes, boxes = _competing_pairs(polylines, reach)
-    return Linework(start, end, tree, pairs, lanes, shapely.STRtree(boxes), polylines)
+    near = reach[lanes] + REACH_MARGIN_M
+    return Linework(start, end, tree, pairs, lanes, near, shapely.STRtree(boxes), polylines)
 
 
 def _competing_pairs(polylines: Polylines, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -181,7 +183,7 @@ def crossings(lw: Linework, px, py, qx, qy) -> tuple[np.ndarray, np.ndarray]:
     walk, line = lw.tree.query(segments)
     found_walk, found_t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
     walk_pairs, pair = lw.pair_tree.query(segments)
-    tie_t, tie = _equal_distances(lw, p[walk_pairs], r[walk_pairs], pair)
+    tie_t, tie = _equal_distances(lw, p[walk_pairs], r[walk_pairs], pair) if len(pair) else (found_t[:0], walk[:0])
     found_walk = np.concatenate([walk[found_walk], walk_pairs[tie]])
     found_t = np.concatenate([found_t, tie_t])
     inside = (found_t > 0) & (found_t < 1)
@@ -224,8 +226,9 @@ def _distance_pieces(polylines: Polylines, segment: np.ndarray, p, r) -> tuple[n
 
 
 def _equal_distances(lw: Linework, p, r, pair) -> tuple[np.ndarray, np.ndarray]:
-    """(t, hit index) where the two segments of ``pair[h]`` are equally near p + t r and no
-    segment of their centreline is nearer (where the nearest segment may jump between them)."""
+    """(t, hit index) where the two segments of ``pair[h]`` are equally near p + t r, within their
+    lane's reach, and no segment of their centreline is nearer (where the nearest segment may jump
+    between them)."""
     i, j = lw.pairs[pair, 0], lw.pairs[pair, 1]
     qi, si = _distance_pieces(lw.polylines, i, p, r)
     qj, sj = _distance_pieces(lw.polylines, j, p, r)
@@ -237,6 +240,8 @@ def _equal_distances(lw: Linework, p, r, pair) -> tuple[np.ndarray, np.ndarray]:
     hit, piece_i, t = hit[valid], piece_i[valid], t[valid]
     quad = qi[hit, piece_i]
     own = np.sqrt(np.maximum(quad[:, 0] * t * t + quad[:, 1] * t + quad[:, 2], 0.0))
+    within = own <= lw.pair_reach[pair[hit]]
+    hit, t, own = hit[within], t[within], own[within]
     points = shapely.points(p[hit] + t[:, None] * r[hit])
     nearest = shapely.distance(points, lw.polylines.geometries[lw.pair_lane[pair[hit]]])
     keep = own <= nearest + TIE_M

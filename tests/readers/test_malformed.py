@@ -79,6 +79,21 @@ def test_parquet_metadata_of_wrong_types_is_one_line(tmp_path, field, value, mes
     assert message in _error(path)
 
 
+def test_parquet_columns_metadata_and_vocabularies_are_named(tmp_path):
+    table = pq.read_table(SAMPLE)
+    meta = json.loads(table.schema.metadata[METADATA_KEY])
+    path = tmp_path / "t.parquet"
+    pq.write_table(table.drop_columns(["vx"]), path)
+    assert "missing column(s) vx" in _error(path)
+    del meta["ego"]
+    pq.write_table(table.replace_schema_metadata({METADATA_KEY: json.dumps(meta)}), path)
+    assert "missing metadata field(s) ego" in _error(path)
+    meta = json.loads(table.schema.metadata[METADATA_KEY])
+    meta["lane_ids"] = meta["lane_ids"][1:]
+    pq.write_table(table.replace_schema_metadata({METADATA_KEY: json.dumps(meta)}), path)
+    assert "is not in the file's vocabulary" in _error(path)
+
+
 @pytest.mark.parametrize("interval", [0, -0.1])
 def test_a_non_positive_frame_interval_is_refused(tmp_path, interval):
     assert "frame_interval" in _json_trace(tmp_path, [_at(0), _at(1)], frame_interval=interval)

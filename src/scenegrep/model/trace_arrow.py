@@ -172,6 +172,22 @@ def _metadata(trace: LabelTrace) -> dict[str, Any]:
     }
 
 
+_META_KEYS = (
+    "name",
+    "ego",
+    "attributes",
+    "objects",
+    "lane_ids",
+    "behaviour_vocabulary",
+    "behaviour_scores",
+    "channels",
+    "box_classes",
+    "source",
+    "map_source",
+)
+"""The fields of a trace table's metadata besides ``layout`` (see :func:`_metadata`)."""
+
+
 def trace_to_table(trace: LabelTrace) -> pa.Table:
     """The trace as one Arrow table with the :data:`SCHEMA`, rows ordered by frame position."""
     blocks = [_state_block(trace)]
@@ -193,10 +209,17 @@ def is_trace_table(schema: pa.Schema) -> bool:
     return bool(schema.metadata) and METADATA_KEY in schema.metadata
 
 
+class _Vocabulary(dict):
+    """Value -> code; a value the file's vocabulary does not hold is a ValueError naming it."""
+
+    def __missing__(self, value: Any) -> int:
+        raise ValueError(f"{value!r} is not in the file's vocabulary")
+
+
 def _codes(column: pa.ChunkedArray | pa.Array, vocabulary: list[str]) -> np.ndarray:
     """Int codes of a dictionary/string column into ``vocabulary`` (-1 for null)."""
     array = column.combine_chunks() if isinstance(column, pa.ChunkedArray) else column
-    position = {v: k for k, v in enumerate(vocabulary)}
+    position = _Vocabulary({v: k for k, v in enumerate(vocabulary)})
     if isinstance(array.type, pa.DictionaryType):
         lookup = np.array([position[v] for v in array.dictionary.to_pylist()] + [-1], dtype=np.int32)
         idx = array.indices.to_numpy(zero_copy_only=False)
@@ -263,6 +286,12 @@ def trace_from_table(table: pa.Table) -> LabelTrace:
     meta = json.loads(table.schema.metadata[METADATA_KEY])
     if meta.get("layout") != LAYOUT_VERSION:
         raise ValueError(f"unsupported trace layout {meta.get('layout')!r} (this scenegrep reads {LAYOUT_VERSION})")
+    missing = [name for name in SCHEMA.names if name not in table.column_names]
+    if missing:
+        raise ValueError(f"missing column(s) {', '.join(missing)}")
+    absent = [key for key in _META_KEYS if key not in meta]
+    if absent:
+        raise ValueError(f"missing metadata field(s) {', '.join(absent)}")
     kind = _codes(table.column("kind"), list(KINDS))
     position = _numpy(table, "position", np.int64)
     n_frames = checked_frame_count(int(position.max()) + 1 if len(position) else 0)

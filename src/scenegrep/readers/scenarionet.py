@@ -183,7 +183,11 @@ def read_trace(path: str | Path) -> LabelTrace:
 
 # ---------------------------------------------------------------------- map
 def _xy(points: Any) -> np.ndarray:
-    return np.asarray(points, dtype=np.float64).reshape(len(points), -1)[:, :2]
+    """The (n, 2) x, y of a map feature's points; ValueError if they are not n points."""
+    try:
+        return np.asarray(points, dtype=np.float64).reshape(len(points), -1)[:, :2]
+    except (ValueError, TypeError):
+        raise ValueError("a map feature's polyline or polygon is not a list of [x, y] or [x, y, z] points") from None
 
 
 def _is_lane(feature: dict[str, Any]) -> bool:

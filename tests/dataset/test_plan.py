@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.dataset.catalog import Catalog
-from scenegrep.dataset.plan import KindGroup, Needs, kind_groups, plan
+from scenegrep.dataset.plan import KindGroup, Needs, TracePlanner, kind_groups, plan
 from scenegrep.dataset.statistics import TraceStatistics
 from scenegrep.model import LabelTrace, ObjectTable, StateTable
 from scenegrep.model.taxonomy import kind_of
@@ -70,6 +70,26 @@ def test_kind_pruning_keeps_every_trace_that_could_match(tmp_path_factory, trace
     if not result.pruned:
         return
     assert "consecutive frames" in result.pruned[0][1]
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.lists(traces(), min_size=1, max_size=3),
+    st.lists(st.sampled_from(KIND_SETS), min_size=1, max_size=3),
+    st.integers(1, 4),
+    st.sampled_from([frozenset(), frozenset({"pedestrian"})]),
+)
+def test_the_trace_planner_gives_the_catalog_planners_reasons(tmp_path_factory, sequence, kind_sets, m, classes):
+    """A query over files plans trace after trace with one TracePlanner: each reason is the one
+    plan() gives on a dataset's catalog holding that trace."""
+    needs = Needs(kind_groups([SimpleNamespace(kinds=k) for k in kind_sets]), m, classes)
+    with TracePlanner(needs) as planner:
+        for trace in sequence:
+            with catalog_of(tmp_path_factory.mktemp("plan"), trace) as catalog:
+                expected = plan(catalog, needs).pruned
+            stats = TraceStatistics.of(trace)
+            row = {"trace_id": "t", **stats.trace, "source_path": "s", "file": "f", "map_id": None}
+            assert planner.prune_reason(row, stats) == (expected[0][1] if expected else None)
 
 
 def test_kind_groups_drop_implied_groups():

@@ -72,7 +72,8 @@ class Catalog:
 
     ``read_only`` connections may be open in several processes at once; a writing connection
     excludes every other process (DuckDB's file lock), so long runs close it while they work.
-    A ``root`` of None is a catalog in memory (a query over files plans each trace with one)."""
+    A ``root`` of None is an empty catalog in memory whose tables :meth:`show_trace` provides
+    (a query over files plans each trace with one)."""
 
     def __init__(self, root: Path | None, create: bool = False, read_only: bool = False):
         self.root = root
@@ -85,7 +86,7 @@ class Catalog:
             self.db = duckdb.connect(":memory:" if path is None else str(path), read_only=read_only)
         except duckdb.IOException as exc:
             raise UserError(f"cannot open the catalog: {str(exc).splitlines()[0]}", at(path)) from None
-        if not read_only:
+        if path is not None and not read_only:
             self.db.execute(SCHEMA)
             self.db.execute("INSERT OR REPLACE INTO meta VALUES ('schema_version', ?)", [SCHEMA_VERSION])
 
@@ -105,6 +106,13 @@ class Catalog:
     def rows(self, query: str, parameters: list[Any] | None = None) -> list[tuple]:
         """Run a SQL statement; its result as tuples."""
         return self.db.execute(query, parameters or []).fetchall()
+
+    def show_trace(self, row: dict[str, Any], statistics: Any) -> None:
+        """(A catalog in memory) let ``traces`` and the per-trace tables hold one trace only: its
+        ``traces`` row and its :class:`~scenegrep.dataset.statistics.TraceStatistics`."""
+        self.db.register("traces", pa.Table.from_pylist([row]))
+        for table in PER_TRACE_TABLES:
+            self.db.register(table, _with_trace_id(getattr(statistics, table), row["trace_id"]))
 
     # ------------------------------------------------------------------ ingest
     def checksums(self) -> dict[str, str]:

@@ -4,7 +4,7 @@ The sources under the given paths are found as ``ingest`` finds them
 (:func:`.ingest.discover`); each trace is read as ingest reads it (:func:`.ingest.prepare_trace`:
 its own road map, unless the query reads no map (a SpRE); labelled with that map when it has no
 behaviour labels, for a scenario query, the only kind that reads labels), planned with the planner's SQL
-on a catalog in memory (:func:`.plan.prune_reason`), and queried by the engine's per-trace
+on a catalog in memory (:class:`.plan.TracePlanner`), and queried by the engine's per-trace
 function (:func:`.queries.query_trace`). So its rows, trace ids included, equal those of the
 same query over a dataset that ingested the same paths. A path, source or trace that fails gives
 a 'failed' row and the others go on.
@@ -22,7 +22,7 @@ from .. import readers
 from ..errors import UserError, at, failure_text
 from ..model import LabelTrace, RoadMap
 from .ingest import Source, catalog_row, discover, prepare_trace, trace_id_of
-from .plan import Needs, needs_of, prune_reason
+from .plan import TracePlanner, needs_of
 from .queries import ORDER, QuerySpec, compiled, match_trace, pruned_row, query_trace, results_table, uses_map
 from .results import Results
 from .run import run_id_of
@@ -37,13 +37,13 @@ def query_files(
     """Run ``spec`` over every trace under ``paths``; ``map_path`` is the road map of traces
     without their own. ``on_rows`` sees each trace's rows (a failed path's or source's row), with
     every column, as soon as they are ready. The results are ordered as a dataset run's, with its run id."""
-    needs = needs_of(spec, compiled(spec))
     sources, bad = discover(paths)
     tables = []
-    for batch in _batches(spec, needs, sources, bad, map_path):
-        tables.append(results_table(batch))
-        if on_rows is not None:
-            on_rows(tables[-1].to_pylist())
+    with TracePlanner(needs_of(spec, compiled(spec))) as planner:
+        for batch in _batches(spec, planner, sources, bad, map_path):
+            tables.append(results_table(batch))
+            if on_rows is not None:
+                on_rows(tables[-1].to_pylist())
     table = pa.concat_tables([results_table([]), *tables]).sort_by(ORDER)
     return Results(table, run_id_of(spec), query=spec.key())
 
@@ -61,13 +61,13 @@ def read_queried_trace(source: str, trace_id: str, map_path: str | None = None) 
 
 
 def _batches(
-    spec: QuerySpec, needs: Needs, sources: list[Source], bad: list[tuple[str, str]], map_path: str | None
+    spec: QuerySpec, planner: TracePlanner, sources: list[Source], bad: list[tuple[str, str]], map_path: str | None
 ) -> Iterator[list[dict[str, Any]]]:
     """The rows of each bad path, then of each trace of each source, in order."""
     for path, error in bad:
         yield [_failed(path, 0, error)]
     for source in sources:
-        yield from _source_rows(spec, needs, source, map_path)
+        yield from _source_rows(spec, planner, source, map_path)
 
 
 def _failed(path: str, number: int, error: str) -> dict[str, Any]:
@@ -77,18 +77,20 @@ def _failed(path: str, number: int, error: str) -> dict[str, Any]:
     return {**identity, "status": "failed", "match": -1, "error": error}
 
 
-def _source_rows(spec: QuerySpec, needs: Needs, source: Source, map_path: str | None) -> Iterator[list[dict[str, Any]]]:
+def _source_rows(
+    spec: QuerySpec, planner: TracePlanner, source: Source, map_path: str | None
+) -> Iterator[list[dict[str, Any]]]:
     """Each trace's rows of one source, then, if reading it failed, the source's failed row."""
     number = 0
     try:
         for number, trace in enumerate(readers.read_traces(source.path, source.format)):
-            yield _trace_rows(spec, needs, source.path, number, trace, map_path)
+            yield _trace_rows(spec, planner, source.path, number, trace, map_path)
     except Exception as exc:  # a bad source must not stop the others
         yield [_failed(source.path, number, failure_text(exc, source.path))]
 
 
 def _trace_rows(
-    spec: QuerySpec, needs: Needs, source: str, number: int, trace: LabelTrace, map_path: str | None
+    spec: QuerySpec, planner: TracePlanner, source: str, number: int, trace: LabelTrace, map_path: str | None
 ) -> list[dict[str, Any]]:
     trace_id = trace_id_of(source, trace.name, number)
     identity = {"trace_id": trace_id, "name": trace.name, "source": source, "time_origin_ns": time_origin_ns(trace)}
@@ -96,7 +98,7 @@ def _trace_rows(
     def rows() -> list[dict[str, Any]]:
         prepared, road_map = prepare_trace(trace, label=spec.kind == "scenario") if uses_map(spec) else (trace, None)
         row, statistics = catalog_row(prepared, trace_id, source, "", None)
-        reason = prune_reason(needs, row, statistics)
+        reason = planner.prune_reason(row, statistics)
         if reason is not None:
             return [pruned_row(reason)]
         if road_map is None and map_path:

@@ -163,13 +163,26 @@ def _prune_by_classes(catalog: Catalog, classes: frozenset[str]) -> dict[str, st
     return reasons
 
 
-def prune_reason(needs: Needs, row: dict[str, Any], statistics: Any) -> str | None:
-    """Why :func:`plan` would prune one trace, given its ``traces`` row and its
-    :class:`~scenegrep.dataset.statistics.TraceStatistics`, or None: the same SQL, on a catalog
-    in memory that holds only this trace (a query over files plans each trace this way)."""
-    if not needs.groups and not needs.classes:
-        return None
-    with Catalog(None, create=True) as catalog:
-        catalog.replace_sources([({"path": row["source_path"], "format": "", "checksum": ""}, [(row, statistics)])])
-        pruned = plan(catalog, needs).pruned
-    return pruned[0][1] if pruned else None
+class TracePlanner:
+    """:func:`plan` for one trace at a time (a query over files): the same SQL, on a catalog in
+    memory that holds only the trace being planned. Use as a context manager."""
+
+    def __init__(self, needs: Needs):
+        self.needs = needs
+        self.catalog = Catalog(None) if needs.groups or needs.classes else None
+
+    def __enter__(self) -> TracePlanner:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.catalog is not None:
+            self.catalog.close()
+
+    def prune_reason(self, row: dict[str, Any], statistics: Any) -> str | None:
+        """Why :func:`plan` would prune the trace of this ``traces`` row and
+        :class:`~scenegrep.dataset.statistics.TraceStatistics`, or None."""
+        if self.catalog is None:
+            return None
+        self.catalog.show_trace(row, statistics)
+        pruned = plan(self.catalog, self.needs).pruned
+        return pruned[0][1] if pruned else None

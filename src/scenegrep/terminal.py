@@ -7,6 +7,8 @@ from __future__ import annotations
 from functools import cache
 from typing import Any, TextIO
 
+from .errors import UserError, at
+
 
 @cache
 def _escapes(keep: str) -> dict[int, str]:
@@ -29,7 +31,20 @@ class EscapingStream:
         self.keep = keep
 
     def write(self, text: str) -> int:
-        return self.stream.write(printable(text, self.keep))
+        try:
+            return self.stream.write(printable(text, self.keep))
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise OutputError(self.stream, exc) from None
+
+    def flush(self) -> None:
+        try:
+            self.stream.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise OutputError(self.stream, exc) from None
 
     def writelines(self, lines: Any) -> None:
         for line in lines:
@@ -37,3 +52,19 @@ class EscapingStream:
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self.stream, name)
+
+
+class OutputError(UserError):
+    """Writing a standard stream failed (disk full); a closed pipe stays a BrokenPipeError, which
+    ends the command quietly."""
+
+    def __init__(self, stream: TextIO, exc: OSError):
+        name = {1: "<stdout>", 2: "<stderr>"}.get(_fileno(stream), "<output>")
+        super().__init__(f"cannot write: {exc.strerror or exc}", at(name))
+
+
+def _fileno(stream: TextIO) -> int | None:
+    try:
+        return stream.fileno()
+    except (OSError, ValueError, AttributeError):
+        return None

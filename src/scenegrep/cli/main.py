@@ -12,7 +12,6 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # scenegrep uses no BLAS threads; idle ones spin on a core
 
 import argparse  # noqa: E402
-import errno  # noqa: E402
 import importlib  # noqa: E402
 import sys  # noqa: E402
 import warnings  # noqa: E402
@@ -20,7 +19,7 @@ from collections.abc import Sequence
 
 from .. import __version__  # noqa: E402
 from ..errors import UserError  # noqa: E402
-from ..terminal import EscapingStream  # noqa: E402
+from ..terminal import EscapingStream, OutputError  # noqa: E402
 
 COMMANDS = ("export", "info", "ingest", "label", "report", "scenario", "scene", "serve", "show", "spre", "synth")
 """Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
@@ -60,15 +59,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     sys.stdout = EscapingStream(stdout)  # type: ignore[assignment]
     sys.stderr = EscapingStream(stderr, keep="\n\t\r")  # type: ignore[assignment]
     try:
-        code = _run(argv)
-        stdout.flush()
-        return code
-    except OSError as exc:
-        if exc.errno not in _OUTPUT_ERRORS or exc.filename is not None:
-            raise
-        _discard_stdout()
-        print(f"scenegrep: error: <stdout>: cannot write: {exc.strerror}", file=sys.stderr)
-        return EXIT_USER_ERROR
+        return _run(argv)
     finally:
         sys.stdout, sys.stderr = stdout, stderr
 
@@ -76,9 +67,6 @@ def main(argv: Sequence[str] | None = None) -> int:
 _FLOATING_POINT = "(invalid value|overflow|divide by zero) encountered"
 """numpy's floating-point warnings: NaN or huge numbers in an input, which the data model then
 accepts (NaN: unknown) or refuses with a one-line error; never a warning's extra lines."""
-
-_OUTPUT_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO)
-"""Errors writing standard output that are the output's fault (disk full, quota, file too big)."""
 
 
 def _discard_stdout() -> None:
@@ -96,8 +84,12 @@ def _run(argv: Sequence[str] | None) -> int:
         if args.command is None:
             parser.print_help()
             return EXIT_USER_ERROR
-        return int(args.run(args))
+        code = int(args.run(args))
+        sys.stdout.flush()
+        return code
     except UserError as exc:
+        if isinstance(exc, OutputError):
+            _discard_stdout()
         print(f"scenegrep: error: {exc.one_line()}", file=sys.stderr)
         if exc.detail:
             print(exc.detail, file=sys.stderr)

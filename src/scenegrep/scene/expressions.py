@@ -22,6 +22,8 @@ if TYPE_CHECKING:
     from .resolve import Resolver
 
 DEG = math.pi / 180
+MAX_CHOICES = 32
+"""Most values of one ``Options``/``Uniform``/``DiscreteRange`` (numpy's ``choose`` takes at most 64 arrays)."""
 
 _BINARY = {"+": "add", "-": "sub", "*": "mul", "/": "div"}
 _COMPARE = {"<": ("lt", False), "<=": ("le", False), ">": ("lt", True), ">=": ("le", True), "==": ("eq", False)}
@@ -306,6 +308,8 @@ def _discrete_range(r: Resolver, node: ir.Call, args: list[Any]) -> Any:
     low, high = (to_num(r, a, n) for a, n in zip(args, node.args))
     if not (low.is_const and high.is_const and float(low.value).is_integer() and float(high.value).is_integer()):
         raise r.error("DiscreteRange needs constant whole-number bounds", node)
+    if high.value - low.value >= MAX_CHOICES:
+        raise r.error(f"a random choice may have at most {MAX_CHOICES} values", node)
     return choose(r, node, tuple(r.f.const(v) for v in range(int(low.value), int(high.value) + 1)))
 
 
@@ -313,6 +317,8 @@ def choose(r: Resolver, node: ir.Node, values: tuple[Any, ...]) -> Any:
     """A random choice among values: numbers, strings, booleans, vectors or regions (one shared index)."""
     if len(values) == 1:
         return values[0]
+    if len(values) > MAX_CHOICES:
+        raise r.error(f"a random choice may have at most {MAX_CHOICES} values", node)
     if all(isinstance(v, Region) for v in values):
         return Union(values)
     index = r.f.choice(FiniteChoice(r.label(node), len(values), node.span))

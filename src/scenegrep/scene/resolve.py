@@ -23,6 +23,9 @@ from .regions import Everywhere, MapField, MapRegion, Nowhere, Union
 from .terms import Term
 from .values import Instance, Namespace
 
+MAX_LOOP_STATEMENTS = 1_000
+"""Most statements all the program's ``for`` loops may run together (each may create an object)."""
+
 SIMULATOR_PARAMS = frozenset(
     {"map", "map_options", "carla_map", "lgsvl_map", "render", "timestep", "time_step", "use2DMap"}
 )
@@ -73,6 +76,7 @@ class Resolver:
         self.params: dict[str, Any] = {}
         self.instances: list[Instance] = []
         self.suffix = ""
+        self.loop_statements = 0
         self.self_view: Any = None
         self.behaviours: dict[str, ir.BehaviourDef] = {}
         """The program's behaviour definitions by name (they do not shape the scene; see :mod:`scenegrep.scenario`)."""
@@ -156,6 +160,9 @@ class Resolver:
         count = self.evaluate(node.count, name=None)
         if not (isinstance(count, Term) and count.is_const and count.kind == "num" and float(count.value).is_integer()):
             raise self.error("a loop count must be a constant whole number", node.count)
+        self.loop_statements += max(0, int(count.value)) * max(1, len(node.body))
+        if self.loop_statements > MAX_LOOP_STATEMENTS:
+            raise self.error(f"loops may run at most {MAX_LOOP_STATEMENTS} statements in all", node.count)
         outer = self.suffix
         for i in range(int(count.value)):
             self.scope[node.variable] = self.f.const(i)

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import ast
 import importlib.util
+import io
 import sys
+import tokenize
 from functools import cache
 from pathlib import Path
 from types import ModuleType
@@ -85,12 +87,70 @@ def read_program(path: str | Path) -> str:
         raise UserError(f"cannot read the program: {error}", at(path)) from None
 
 
+MAX_TOKENS = 2_000
+"""Most tokens a program may have (Scenic's parser takes about 1 ms per token; the largest
+example program has under 400)."""
+
+MAX_NESTING = 100
+"""Deepest nesting of brackets, and of expressions in the parsed program (a chain of binary
+operators nests one level per operator)."""
+
+RECURSION_LIMIT = 20_000
+"""Python's recursion limit while Scenic's (pure Python) parser runs: it needs about 25 frames
+per bracket level."""
+
+
 def parse_scenic(text: str, filename: str) -> ast.Module:
-    """Parse Scenic source text with Scenic's parser; syntax errors become one-line :class:`UserError`."""
+    """Parse Scenic source text with Scenic's parser after checking its size and nesting (see
+    :data:`MAX_TOKENS`, :data:`MAX_NESTING`); syntax errors and programs over a limit become
+    one-line :class:`UserError` at line:column."""
+    _check_tokens(text, filename)
+    limit = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(limit, RECURSION_LIMIT))
     try:
-        return scenic_parser().parse_string(text, "exec", filename=filename)
+        module = scenic_parser().parse_string(text, "exec", filename=filename)
     except Exception as error:  # Scenic raises its own ScenicParseError (or our stand-in)
         raise _syntax_error(error, filename) from None
+    finally:
+        sys.setrecursionlimit(limit)
+    _check_depth(module, filename)
+    return module
+
+
+def _check_tokens(text: str, filename: str) -> None:
+    """At most :data:`MAX_TOKENS` tokens and :data:`MAX_NESTING` levels of brackets, by Python's
+    tokenizer (Scenic's lexical structure); text it cannot tokenize is left to Scenic's parser."""
+    depth = 0
+    try:
+        for count, token in enumerate(tokenize.generate_tokens(io.StringIO(text).readline), 1):
+            if count > MAX_TOKENS:
+                raise _limit_error(f"the program has more than {MAX_TOKENS} tokens", token.start, filename)
+            if token.type != tokenize.OP:
+                continue
+            if token.string in "([{":
+                depth += 1
+                if depth > MAX_NESTING:
+                    raise _limit_error(f"brackets nest more than {MAX_NESTING} levels deep", token.start, filename)
+            elif token.string in ")]}":
+                depth -= 1
+    except (tokenize.TokenError, SyntaxError):
+        return
+
+
+def _check_depth(module: ast.Module, filename: str) -> None:
+    """No expression or statement nested more than :data:`MAX_NESTING` levels (found without recursion)."""
+    stack: list[tuple[ast.AST, int, tuple[int, int]]] = [(module, 0, (1, 0))]
+    while stack:
+        node, depth, place = stack.pop()
+        place = (node.lineno, node.col_offset) if hasattr(node, "lineno") else place
+        if depth > MAX_NESTING:
+            raise _limit_error(f"the program nests more than {MAX_NESTING} levels deep", place, filename)
+        stack.extend((child, depth + 1, place) for child in ast.iter_child_nodes(node))
+
+
+def _limit_error(message: str, place: tuple[int, int], filename: str) -> UserError:
+    """A limit error at a (line, 0-based column) place."""
+    return UserError(message, at(filename, place[0], place[1] + 1))
 
 
 def _syntax_error(error: Exception, filename: str) -> UserError:

@@ -12,8 +12,9 @@ model scenic.domains.driving.model
 #   region of a Car: 50 m, 90 deg cone ahead), any heading, with its centre
 #   within 10 m of the ego's.
 # - Cars are Scenic's Car: labelled class car (not trucks, buses, bikes). Their
-#   boxes need not lie wholly on the road: scenegrep treats Scenic's default
-#   road-or-shoulder containment as unknown on maps without shoulders.
+#   boxes must lie in Scenic's default road-or-shoulder; maps without a shoulder
+#   layer (nuScenes) need --unknown-layers permissive (boxes need not lie wholly
+#   on the road) or strict (wholly in the lanes).
 # - Run with --visible-distance 50, as in the paper.
 
 ego = new Car on network.laneRegion, facing Range(150, 210) deg relative to roadDirection

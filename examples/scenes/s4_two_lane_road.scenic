@@ -18,8 +18,9 @@ model scenic.domains.driving.model
 #   (and `ego.lane` is only the map's lane segment under the ego, typically
 #   15-20 m long), so "two-lane road" is this lateral layout.
 # - Cars are Scenic's Car: labelled class car (not trucks, buses, bikes). Their
-#   boxes need not lie wholly on the road: scenegrep treats Scenic's default
-#   road-or-shoulder containment as unknown on maps without shoulders.
+#   boxes must lie in Scenic's default road-or-shoulder; maps without a shoulder
+#   layer (nuScenes) need --unknown-layers permissive (boxes need not lie wholly
+#   on the road) or strict (wholly in the lanes).
 # - Run with --visible-distance 50, as in the paper.
 
 ego = new Car on network.laneRegion, facing Range(-15, 15) deg relative to roadDirection

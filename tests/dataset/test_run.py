@@ -23,6 +23,7 @@ from scenegrep.scenario import ScenarioOptions, load_scenario
 from scenegrep.scene import SceneOptions, Tolerance, load_scene
 from scenegrep.spre import TraceSearch, compile_query
 
+from scenegrep.model.layers import UnknownLayers
 from .conftest import REPO
 
 pytestmark = pytest.mark.real_data
@@ -31,12 +32,15 @@ SCENARIO = REPO / "examples/queries/s1_lane_change_stationary_car.scenic"
 SCENE = REPO / "examples/scenes/fig3_car_ahead.scenic"
 SPRE = "[[:pedestrian:]][[:bicycle:]]"
 TOLERANCE = {"tolerance_position": 0.5, "tolerance_heading": 0.1}
+UNKNOWN = "strict"
+"""Map layers a map does not publish (nuScenes' crosswalks, shoulders) taken as empty, as the
+ingest of the ``real_dataset`` fixture labels them."""
 
 
 def specs() -> dict[str, QuerySpec]:
     return {
-        "scenario": QuerySpec.from_file("scenario", SCENARIO, window=75),
-        "scene": QuerySpec.from_file("scene", SCENE, **TOLERANCE),
+        "scenario": QuerySpec.from_file("scenario", SCENARIO, window=75, unknown_layers=UNKNOWN),
+        "scene": QuerySpec.from_file("scene", SCENE, **TOLERANCE, unknown_layers=UNKNOWN),
         "spre": QuerySpec.of("spre", SPRE),
     }
 
@@ -53,11 +57,14 @@ def one_by_one(kind: str, root: Path) -> dict[str, list[tuple]]:
         for trace in readers.read_traces(source):
             road_map = readers.read_map(trace.map_source) if trace.map_source else None
             if kind == "scenario":
-                trace = label_trace(trace, road_map).trace if trace.behaviours is None else trace
-                result = scenario.match(trace, 75, road_map, ScenarioOptions())
+                choice = UnknownLayers(UNKNOWN)
+                trace = label_trace(trace, road_map, unknown_layers=choice).trace if trace.behaviours is None else trace
+                result = scenario.match(trace, 75, road_map, ScenarioOptions(unknown_layers=choice))
                 windows = [(m.correspondence, first, last) for m, first, last in result.windows()[:1]]
             elif kind == "scene":
-                result = scene.match(trace, road_map, SceneOptions(Tolerance(0.5, 0.1)))
+                result = scene.match(
+                    trace, road_map, SceneOptions(Tolerance(0.5, 0.1), unknown_layers=UnknownLayers(UNKNOWN))
+                )
                 windows = [(result.correspondence(f), f, f) for f in result.frames().tolist()]
             else:
                 windows = [(m.bound or {}, m.start, m.end - 1) for m in TraceSearch(spre, trace).offline()]

@@ -1,6 +1,8 @@
 """RoadMap point queries against brute-force shapely checks, directions, cropping, round trip."""
 
+import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -8,7 +10,7 @@ import shapely
 from hypothesis import given
 from hypothesis import strategies as st
 
-from scenegrep.model.map_arrow import map_from_table, map_to_table
+from scenegrep.model.map_arrow import METADATA_KEY, map_from_table, map_to_table
 from tests.model.maps import synthetic_map
 
 ROAD_MAP = synthetic_map()
@@ -73,6 +75,30 @@ def test_crop_keeps_only_nearby_elements():
 def test_map_table_round_trip():
     assert map_from_table(map_to_table(ROAD_MAP)).equals(ROAD_MAP)
     assert not map_from_table(map_to_table(ROAD_MAP.crop(0, 0, 5))).equals(ROAD_MAP)
+
+
+def test_map_table_round_trips_the_unknown_layers():
+    assert ROAD_MAP.unknown_layers == {"sidewalk", "shoulder"}
+    assert map_from_table(map_to_table(ROAD_MAP)).unknown_layers == ROAD_MAP.unknown_layers
+    published = replace(ROAD_MAP, unknown_layers=frozenset())
+    assert map_from_table(map_to_table(published)).equals(published)
+    assert not map_from_table(map_to_table(published)).equals(ROAD_MAP)
+
+
+def test_an_older_map_table_has_the_optional_layers_it_holds_nothing_of_unknown():
+    """Layout 1 (before layers were told apart) took a layer without elements to be unknown."""
+    table = map_to_table(replace(ROAD_MAP, unknown_layers=frozenset()))
+    meta = json.loads(table.schema.metadata[METADATA_KEY])
+    meta["layout"] = 1
+    del meta["unknown_layers"]
+    older = table.replace_schema_metadata({METADATA_KEY: json.dumps(meta).encode()})
+    # the synthetic map holds crosswalks and curbs, but no sidewalks or shoulders
+    assert map_from_table(older).unknown_layers == {"sidewalk", "shoulder"}
+
+
+def test_only_optional_layers_may_be_unknown():
+    with pytest.raises(ValueError, match="only crossing, sidewalk, curb, shoulder may be unknown"):
+        replace(ROAD_MAP, unknown_layers=frozenset({"lane"}))
 
 
 def test_point_queries_reuse_the_lane_pairs_they_are_given():

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from scenegrep.model import LabelTrace, ObjectTable, StateTable
+from scenegrep.model.layers import UnknownLayers
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
 from tests.model.maps import synthetic_map
 
@@ -41,7 +42,9 @@ def trace_of(*frames: dict) -> LabelTrace:
 
 
 def matches(program: str, *frames: dict, **options) -> list[bool]:
-    """Which frames match the program (header added), on the synthetic map."""
+    """Which frames match the program (header added), on the synthetic map; its unknown layers
+    (sidewalks, shoulders) are taken as everywhere unless ``unknown_layers`` says otherwise."""
+    options.setdefault("unknown_layers", UnknownLayers("permissive"))
     query = compile_scene(HEADER + program, "test.scenic", options.pop("visible_distance_compile", None))
     tolerance = Tolerance(options.pop("position", 1e-6), options.pop("heading", 1e-6), options.pop("speed", 1e-6))
     result = query.match(trace_of(*frames), MAP, SceneOptions(tolerance, **options))

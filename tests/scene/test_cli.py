@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import pyarrow.parquet as pq
 import pytest
@@ -17,14 +18,17 @@ PROGRAM = HEADER + "ego = new Car on road\nother = new Car ahead of ego by Range
 
 @pytest.fixture
 def files(tmp_path):
-    """A program, a two-frame trace (frame 0 matches: a car 6 m ahead; frame 1 does not) and a map."""
+    """A program, a two-frame trace (frame 0 matches: a car 6 m ahead; frame 1 does not), the
+    synthetic map as a map that publishes every layer (``map.parquet``: no sidewalks or shoulders)
+    and as it is (``unknown.parquet``: its sidewalks and shoulders are unknown)."""
     (tmp_path / "ahead.scenic").write_text(PROGRAM)
     trace = trace_of(
         {"ego": ("Car", 1.75, 20.0, 0.0), "c": ("Car", 1.75, 30.5, 0.0)},
         {"ego": ("Car", 1.75, 20.0, 0.0), "c": ("Car", 5.25, 30.5, 0.0)},
     )
     write_trace_json(trace, tmp_path / "trace.json")
-    write_map_parquet(MAP, tmp_path / "map.parquet")
+    write_map_parquet(replace(MAP, unknown_layers=frozenset()), tmp_path / "map.parquet")
+    write_map_parquet(MAP, tmp_path / "unknown.parquet")
     return tmp_path
 
 
@@ -80,14 +84,18 @@ def test_exit_code_options_and_quiet(files, capsys):
     [
         ("ego = new Car on\n", 2, "scenegrep: error: {p}:2:17: Scenic syntax error"),
         ("import math\nego = new Car\n", 2, "scenegrep: error: {p}:2:1: imports are not supported"),
-        ("ego = new Car on sidewalk\n", 3, "scenegrep: failed: hand: {p}: the program names map layers"),
+        (
+            "ego = new Car on sidewalk\n",
+            3,
+            "scenegrep: failed: hand: {p}:2:7: the road map 'synthetic' does not publish",
+        ),
     ],
 )
 def test_errors_are_one_line_with_the_place(files, capsys, text, status, expected):
     """Errors in the program stop the command (2); one that a trace's map causes fails that trace (3)."""
     program = files / "bad.scenic"
     program.write_text(HEADER + text)
-    code, _, err = run([program, files / "trace.json", "--map", files / "map.parquet"], capsys)
+    code, _, err = run([program, files / "trace.json", "--map", files / "unknown.parquet"], capsys)
     assert code == status and err[0].startswith(expected.format(p=program))
     assert not any("Traceback" in line for line in err)
 

@@ -13,10 +13,15 @@ import math
 import pytest
 
 from scenegrep.errors import UserError
+from scenegrep.model.layers import UnknownLayers
+from scenegrep.scene import SceneOptions
 from tests.scene.frames import ahead, matches, right
 
 NORTH, SOUTH, EAST, WEST = 0.0, math.pi, -math.pi / 2, math.pi / 2
 EGO = ("Car", 1.75, 20.0, NORTH)  # centred in lane n1
+
+PERMISSIVE = SceneOptions(unknown_layers=UnknownLayers("permissive"))
+"""The synthetic map's unknown layers (sidewalks, shoulders) taken as everywhere."""
 
 
 def ego(**changes) -> tuple:
@@ -62,16 +67,25 @@ def test_on_curb_takes_the_curb_direction():
     ) == [True]
 
 
-def test_a_default_region_in_a_layer_the_map_lacks_constrains_nothing():
-    # the synthetic map has a crosswalk but no sidewalks, so a pedestrian's default region
-    # (sidewalks and crossings) is unknown: it may be anywhere
+def test_a_default_region_in_an_unknown_layer_is_an_error_or_the_users_choice():
+    # the synthetic map publishes crosswalks but no sidewalks, so a pedestrian's default region
+    # (sidewalks and crossings) needs the unknown sidewalk layer
     program = "ego = new Car on road\nped = new Pedestrian"
-    assert matches(program, {"ego": EGO, "p": ("Pedestrian", 2.0, 61.5, 1.0)}) == [True]
-    assert matches(program, {"ego": EGO, "p": ("Pedestrian", 2.0, 70.0, 1.0)}) == [True]
-    # crossings alone are known
-    program = "ego = new Car on road\nped = new Pedestrian on network.crossingRegion"
-    assert matches(program, {"ego": EGO, "p": ("Pedestrian", 2.0, 61.5, 1.0)}) == [True]
-    assert matches(program, {"ego": EGO, "p": ("Pedestrian", 2.0, 70.0, 1.0)}) == [False]
+    on_crosswalk = {"ego": EGO, "p": ("Pedestrian", 2.0, 61.5, 1.0)}
+    off_crosswalk = {"ego": EGO, "p": ("Pedestrian", 2.0, 70.0, 1.0)}
+    with pytest.raises(
+        UserError, match="3:7: .*does not publish the sidewalk layer, which the x of Pedestrian ped needs"
+    ):
+        matches(program, on_crosswalk, unknown_layers=None)
+    # permissive: sidewalks everywhere; strict: no sidewalks, so only the crosswalk holds it
+    assert matches(program, on_crosswalk, off_crosswalk) == [True, True]
+    assert matches(program, on_crosswalk, off_crosswalk, unknown_layers=UnknownLayers("strict")) == [True, False]
+    # crossings alone are published: no choice needed (the car's default road-or-shoulder needs shoulders)
+    program = (
+        "ego = new Car on road, with regionContainedIn None\n"
+        "ped = new Pedestrian on network.crossingRegion, with regionContainedIn None"
+    )
+    assert matches(program, on_crosswalk, off_crosswalk, unknown_layers=None) == [True, False]
 
 
 # ---------------------------------------------------------------------------- relative placement
@@ -240,11 +254,11 @@ def test_a_distribution_in_a_requirement_is_existential():
 
 
 def test_soft_requirements_are_reported_not_enforced():
-    from scenegrep.scene import SceneOptions, compile_scene
+    from scenegrep.scene import compile_scene
     from tests.scene.frames import HEADER, MAP, trace_of
 
     query = compile_scene(HEADER + "ego = new Car on road\nrequire[0.5] ego.position.y > 50", "soft.scenic")
-    result = query.match(trace_of({"ego": EGO}, {"ego": ego(y=60.0)}), MAP, SceneOptions())
+    result = query.match(trace_of({"ego": EGO}, {"ego": ego(y=60.0)}), MAP, PERMISSIVE)
     assert result.matched.tolist() == [True, True]
     assert result.soft == {"require ego.position.y > 50": pytest.approx([False, True])}
 
@@ -273,16 +287,16 @@ def test_implicit_requirements():
 def test_parameters_are_checked_against_trace_attributes():
     import dataclasses
 
-    from scenegrep.scene import SceneOptions, compile_scene
+    from scenegrep.scene import compile_scene
     from tests.scene.frames import HEADER, MAP, trace_of
 
     query = compile_scene(HEADER + "param weather = Options(['rain', 'fog'])\nego = new Car on road", "p.scenic")
     trace = trace_of({"ego": EGO})
-    assert query.match(trace, MAP, SceneOptions()).matched.tolist() == [True]  # no attribute: not checked
+    assert query.match(trace, MAP, PERMISSIVE).matched.tolist() == [True]  # no attribute: not checked
     rainy = dataclasses.replace(trace, attributes={"weather": "rain"})
     sunny = dataclasses.replace(trace, attributes={"weather": "sun"})
-    assert query.match(rainy, MAP, SceneOptions()).matched.tolist() == [True]
-    assert query.match(sunny, MAP, SceneOptions()).matched.tolist() == [False]
+    assert query.match(rainy, MAP, PERMISSIVE).matched.tolist() == [True]
+    assert query.match(sunny, MAP, PERMISSIVE).matched.tolist() == [False]
 
 
 def test_loops_create_one_object_per_iteration():
@@ -307,6 +321,20 @@ def test_the_jointly_dependent_spot_of_fig6():
     assert matches(program, frame) == [False]
 
 
-def test_missing_map_layer_used_explicitly_is_an_error():
-    with pytest.raises(UserError, match="does not have: sidewalk"):
-        matches("ego = new Car on road\np = new Pedestrian on sidewalk", {"ego": EGO, "p": ("Pedestrian", 0, 0, 0)})
+def test_unknown_map_layer_used_explicitly_is_an_error_naming_it_and_the_object():
+    with pytest.raises(UserError, match=r"test.scenic:3:\d+: .*does not publish the sidewalk layer, which the x of"):
+        matches(
+            "ego = new Car on road\np = new Pedestrian on sidewalk, with regionContainedIn None",
+            {"ego": EGO, "p": ("Pedestrian", 0, 0, 0)},
+            unknown_layers=None,
+        )
+
+
+def test_choice_counts_the_decisions_it_affected():
+    choice = UnknownLayers("permissive")
+    program = "ego = new Car on road\nped = new Pedestrian"
+    # the pedestrian off the crosswalk is decided by the assumption, the one on it is not
+    frames = ({"ego": EGO, "p": ("Pedestrian", 2.0, 61.5, 1.0)}, {"ego": EGO, "p": ("Pedestrian", 2.0, 70.0, 1.0)})
+    assert matches(program, *frames, unknown_layers=choice) == [True, True]
+    assert choice.decisions["sidewalk"] >= 1
+    assert "decisions affected: sidewalk" in choice.report()

@@ -21,6 +21,7 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
+from .layers import report_unknown_layers
 from .main import EXIT_INTERRUPTED, EXIT_SOME_FAILED
 
 NO_MATCH = 1
@@ -68,6 +69,10 @@ def run_query_command(
     counts = results.counts()
     if not args.quiet:
         _summary(results, where or (f"; results in {args.output}" if args.output else ""))
+    if kind != "spre":
+        from ..dataset.queries import spec_choice
+
+        report_unknown_layers(spec_choice(spec), counted=not args.dataset)
         if kind != "spre" and not counts["matched"]:
             _nearest_misses(spec, results, args)
     if results.status == "interrupted":
@@ -197,7 +202,7 @@ def _file_trace(rows: list[dict[str, Any]], args: argparse.Namespace, trace_id: 
     from ..dataset.files import read_queried_trace
 
     (source,) = {row["source"] for row in rows if row["trace_id"] == trace_id}
-    return read_queried_trace(source, trace_id, getattr(args, "map", None))
+    return read_queried_trace(source, trace_id, getattr(args, "map", None), getattr(args, "unknown_layers", None))
 
 
 def _report_plan(plan: Any) -> None:

@@ -13,6 +13,7 @@ import argparse
 import sys
 from typing import Any
 
+from .layers import add_unknown_layers_argument, report_unknown_layers
 from .main import EXIT_SOME_FAILED
 
 
@@ -31,6 +32,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes (default: all cores)")
     parser.add_argument("--no-label", action="store_true", help="do not label traces without behaviour labels")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
+    add_unknown_layers_argument(parser)
     parser.set_defaults(run=run)
 
 
@@ -41,7 +43,14 @@ def run(args: argparse.Namespace) -> int:
 
     show = not args.quiet and sys.stderr.isatty()
     with tqdm(unit="source", file=sys.stderr, disable=not show, leave=False) as bar:
-        report = ingest(args.sources, args.into, args.jobs, not args.no_label, on_outcome=lambda _: bar.update())
+        report = ingest(
+            args.sources,
+            args.into,
+            args.jobs,
+            not args.no_label,
+            on_outcome=lambda _: bar.update(),
+            unknown_layers=args.unknown_layers,
+        )
     for path, error in report.failed:
         print(f"scenegrep: error: {error if error.startswith(path) else f'{path}: {error}'}", file=sys.stderr)
     if not args.quiet:
@@ -50,4 +59,7 @@ def run(args: argparse.Namespace) -> int:
             f"{len(report.failed)} failed; dataset {args.into}",
             file=sys.stderr,
         )
+    from ..model.layers import UnknownLayers
+
+    report_unknown_layers(UnknownLayers(args.unknown_layers, report.assumed))
     return EXIT_SOME_FAILED if report.failed else 0

@@ -15,6 +15,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from .layers import add_unknown_layers_argument, report_unknown_layers, unknown_layers_of
+
 
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
@@ -33,6 +35,7 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print the statistics as JSON")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_unknown_layers_argument(parser)
     parser.set_defaults(run=run)
 
 
@@ -52,17 +55,19 @@ def run(args: argparse.Namespace) -> int:
     output = Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
     statistics = LabelStatistics()
+    choice = unknown_layers_of(args)
     names: set[str] = set()
     with tqdm(desc="labelling", unit=" traces", disable=args.quiet, file=sys.stderr, delay=0.5) as progress:
         for path in args.data:
             for trace in readers.read_traces(path):
                 road_map = fixed_map or (readers.read_map(trace.map_source) if trace.map_source else None)
-                labelled = label_trace(trace, road_map, config, args.min_confidence).trace
+                labelled = label_trace(trace, road_map, config, args.min_confidence, choice).trace
                 write_trace_parquet(labelled, output / f"{_unique(trace.name, names)}.parquet")
                 statistics.add(labelled)
                 progress.update()
     text = json.dumps(statistics.as_dict(), indent=1) if args.json else statistics.table()
     sys.stdout.write(text + "\n")
+    report_unknown_layers(choice)
     return 0
 
 

@@ -18,6 +18,7 @@ import sys
 from typing import Any
 
 from .dataset_run import RowPrinter, add_dataset_arguments, reject_dataset_only, run_query_command
+from .layers import report_unknown_layers, unknown_layers_of
 from .scene import add_tolerance_arguments, tolerance_of, tolerance_options
 
 NO_MATCH = 1
@@ -81,9 +82,9 @@ def _run_online(args: argparse.Namespace) -> int:
     reject_dataset_only(args)
     query = load_scenario(args.program, load_vocabulary(args.vocabulary), args.visible_distance)
     road_map = readers.read_map(args.map) if args.map else None
-    online = OnlineScenario(
-        query, args.window, road_map, ScenarioOptions(tolerance_of(args), args.visible_distance, args.all)
-    )
+    choice = unknown_layers_of(args)
+    options = ScenarioOptions(tolerance_of(args), args.visible_distance, args.all, unknown_layers=choice)
+    online = OnlineScenario(query, args.window, road_map, options)
     printer = RowPrinter(args)
     found = False
     for number, line in enumerate(sys.stdin.buffer, start=1):
@@ -91,9 +92,10 @@ def _run_online(args: argparse.Namespace) -> int:
             continue
         chunk = decode(line, f"<stdin>:{number}", "stdin")
         if chunk.behaviours is None:
-            chunk = label_trace(chunk, road_map).trace
+            chunk = label_trace(chunk, road_map, unknown_layers=choice).trace
         for result in online.push(chunk):
             identity = {"trace_id": result.trace.name, "name": result.trace.name, "source": "<stdin>"}
             printer([{**identity, **row} for row in scenario_rows(result, args.all, args.explain)])
             found |= result.matched
+    report_unknown_layers(choice)
     return 0 if found else NO_MATCH

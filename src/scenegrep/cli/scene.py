@@ -13,6 +13,7 @@ import argparse
 from typing import Any
 
 from .dataset_run import add_dataset_arguments, run_query_command
+from .layers import add_unknown_layers_argument
 
 
 def add_parser(subparsers: Any) -> None:
@@ -60,6 +61,7 @@ def add_tolerance_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--tolerance-speed", type=float, metavar="M/S", help="speed and velocity tolerance (m/s; default 1e-6)"
     )
+    add_unknown_layers_argument(parser)
 
 
 def tolerance_of(args: argparse.Namespace) -> Any:
@@ -83,6 +85,7 @@ def tolerance_options(args: argparse.Namespace) -> dict[str, Any]:
         "tolerance_position": args.tolerance_position,
         "tolerance_heading": args.tolerance_heading,
         "tolerance_speed": args.tolerance_speed,
+        "unknown_layers": args.unknown_layers,
     }
 
 

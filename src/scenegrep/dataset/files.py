@@ -21,9 +21,20 @@ import pyarrow as pa
 from .. import readers
 from ..errors import UserError, at, failure_text
 from ..model import LabelTrace, RoadMap
+from ..model.layers import UnknownLayers
 from .ingest import Source, catalog_row, discover, prepare_trace, trace_id_of
 from .plan import TracePlanner, needs_of
-from .queries import ORDER, QuerySpec, compiled, match_trace, pruned_row, query_trace, results_table, uses_map
+from .queries import (
+    ORDER,
+    QuerySpec,
+    compiled,
+    match_trace,
+    pruned_row,
+    query_trace,
+    results_table,
+    spec_choice,
+    uses_map,
+)
 from .results import Results
 from .run import run_id_of
 from .statistics import time_origin_ns
@@ -48,12 +59,15 @@ def query_files(
     return Results(table, run_id_of(spec), query=spec.key())
 
 
-def read_queried_trace(source: str, trace_id: str, map_path: str | None = None) -> tuple[LabelTrace, RoadMap | None]:
+def read_queried_trace(
+    source: str, trace_id: str, map_path: str | None = None, unknown_layers: str | None = None
+) -> tuple[LabelTrace, RoadMap | None]:
     """The trace ``trace_id`` of a query over files and its road map (its own, else ``map_path``'s),
-    read from its ``source`` as the query read it (UserError if the source no longer holds it)."""
+    read from its ``source`` as the query read it, labelled under the query's choice for unknown
+    map layers (UserError if the source no longer holds it)."""
     for number, trace in enumerate(readers.read_traces(source)):
         if trace_id_of(source, trace.name, number) == trace_id:
-            prepared, road_map = prepare_trace(trace, label=True)
+            prepared, road_map = prepare_trace(trace, label=True, unknown_layers=UnknownLayers(unknown_layers))
             if road_map is None and map_path:
                 road_map = readers.read_map(map_path)
             return prepared, road_map
@@ -96,7 +110,8 @@ def _trace_rows(
     identity = {"trace_id": trace_id, "name": trace.name, "source": source, "time_origin_ns": time_origin_ns(trace)}
 
     def rows() -> list[dict[str, Any]]:
-        prepared, road_map = prepare_trace(trace, label=spec.kind == "scenario") if uses_map(spec) else (trace, None)
+        labelled = spec.kind == "scenario"
+        prepared, road_map = prepare_trace(trace, labelled, spec_choice(spec)) if uses_map(spec) else (trace, None)
         row, statistics = catalog_row(prepared, trace_id, source, "", None)
         reason = planner.prune_reason(row, statistics)
         if reason is not None:

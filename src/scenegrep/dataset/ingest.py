@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,6 +26,7 @@ from typing import Any
 from .. import readers
 from ..errors import UserError, at, failure_text
 from ..model import LabelTrace, RoadMap
+from ..model.layers import UnknownLayers
 from ..readers.trace_folder import SKIPPED
 from .catalog import Catalog
 from .execute import run_all
@@ -48,12 +50,14 @@ class Source:
 @dataclass(frozen=True)
 class IngestTask:
     """What a worker needs to ingest one source: it, the dataset root, the checksum the
-    catalog has for it (None if new) and whether to label traces without behaviour labels."""
+    catalog has for it (None if new), whether to label traces without behaviour labels, and the
+    labeller's choice for map layers a map does not publish (see :mod:`scenegrep.model.layers`)."""
 
     source: Source
     root: str
     known_checksum: str | None
     label: bool
+    unknown_layers: str | None = None
 
 
 @dataclass
@@ -69,16 +73,20 @@ class SourceOutcome:
     traces: list[tuple[dict[str, Any], TraceStatistics]] = field(default_factory=list)
     maps: list[dict[str, Any]] = field(default_factory=list)
     error: str = ""
+    assumed: Counter[str] = field(default_factory=Counter)
+    """Labelling decisions the choice for unknown map layers affected, per layer."""
 
 
 @dataclass
 class IngestReport:
-    """Counts of an ingest run and the failed sources (path, one-line error)."""
+    """Counts of an ingest run, the failed sources (path, one-line error) and the labelling
+    decisions the choice for unknown map layers affected, per layer."""
 
     ingested: int = 0
     unchanged: int = 0
     traces: int = 0
     failed: list[tuple[str, str]] = field(default_factory=list)
+    assumed: Counter[str] = field(default_factory=Counter)
 
 
 def discover(paths: list[str]) -> tuple[list[Source], list[tuple[str, str]]]:
@@ -173,22 +181,27 @@ def ingest_source(task: IngestTask) -> SourceOutcome:
         if digest == task.known_checksum:
             return SourceOutcome(source, "unchanged", digest)
         outcome = SourceOutcome(source, "ingested", digest, replaces=task.known_checksum is not None)
+        choice = UnknownLayers(task.unknown_layers)
         for number, trace in enumerate(readers.read_traces(source.path, source.format)):
-            outcome.traces.append(_write_trace(trace, number, task, outcome.maps))
+            outcome.traces.append(_write_trace(trace, number, task, outcome.maps, choice))
+        outcome.assumed = choice.decisions
         return outcome
     except Exception as exc:  # a bad source, or a reader's bug, must not stop the other sources
         return SourceOutcome(source, "failed", error=failure_text(exc, source.path))
 
 
-def prepare_trace(trace: LabelTrace, label: bool) -> tuple[LabelTrace, RoadMap | None]:
+def prepare_trace(
+    trace: LabelTrace, label: bool, unknown_layers: UnknownLayers | None = None
+) -> tuple[LabelTrace, RoadMap | None]:
     """A trace as a dataset holds it, and its own road map (None when it names none): when
     ``label`` and it has no behaviour labels, labelled with that map by ``scenegrep label``'s
-    labeller. Ingest and a query over files both read traces this way."""
+    labeller, under the choice ``unknown_layers`` for map layers the map does not publish. Ingest
+    and a query over files both read traces this way."""
     road_map = None if trace.map_source is None else readers.read_map(trace.map_source)
     if label and trace.behaviours is None:
         from ..label import label_trace
 
-        trace = label_trace(trace, road_map).trace
+        trace = label_trace(trace, road_map, unknown_layers=unknown_layers).trace
     return trace, road_map
 
 
@@ -201,11 +214,13 @@ def catalog_row(
     return row, stats
 
 
-def _write_trace(trace: LabelTrace, number: int, task: IngestTask, maps: list[dict[str, Any]]) -> tuple[dict, Any]:
+def _write_trace(
+    trace: LabelTrace, number: int, task: IngestTask, maps: list[dict[str, Any]], choice: UnknownLayers
+) -> tuple[dict, Any]:
     from ..writers.trace_parquet import write_map_parquet, write_trace_parquet
 
     root = Path(task.root)
-    trace, road_map = prepare_trace(trace, task.label)
+    trace, road_map = prepare_trace(trace, task.label, choice)
     map_id = None
     if road_map is not None:
         ms = trace.map_source
@@ -234,9 +249,12 @@ def ingest(
     jobs: int | None = None,
     label: bool = True,
     on_outcome: Callable[[SourceOutcome], None] | None = None,
+    unknown_layers: str | None = None,
 ) -> IngestReport:
     """Ingest every source under ``paths`` into the dataset ``into`` (created if needed) with
-    ``jobs`` local workers; ``on_outcome`` sees each source's outcome as it is committed."""
+    ``jobs`` local workers; ``on_outcome`` sees each source's outcome as it is committed;
+    ``unknown_layers`` is the labeller's choice for map layers a map does not publish."""
+    UnknownLayers(unknown_layers)
     root = Path(into).resolve()
     sources, bad = discover(paths)
     with Catalog(root, create=True) as catalog:
@@ -244,7 +262,7 @@ def ingest(
         for path, error in bad:
             catalog.record_source_error(path, error)
     _remove_stale_temporaries(root)
-    tasks = [IngestTask(s, str(root), known.get(s.path), label) for s in sources]
+    tasks = [IngestTask(s, str(root), known.get(s.path), label, unknown_layers) for s in sources]
     report = IngestReport(failed=list(bad))
     results = run_all(ingest_source, tasks, jobs)
     batch: list[SourceOutcome] = []
@@ -277,5 +295,7 @@ def _commit(catalog: Catalog, root: Path, batch: list[SourceOutcome], report: In
     )
     for stale in old_files - {row["file"] for o in ingested for row, _ in o.traces}:
         os.unlink(root / stale)
+    for outcome in ingested:
+        report.assumed.update(outcome.assumed)
     report.ingested += len(ingested)
     report.traces += sum(len(o.traces) for o in ingested)

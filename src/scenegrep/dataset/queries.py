@@ -22,6 +22,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -65,6 +66,7 @@ OPTIONS: dict[str, dict[str, Any]] = {
         "vocabulary": None,
         "all": False,
         "explain": False,
+        "unknown_layers": None,
     },
     "scene": {
         "tolerance_profile": None,
@@ -75,6 +77,7 @@ OPTIONS: dict[str, dict[str, Any]] = {
         "exact": False,
         "explain": False,
         "values": False,
+        "unknown_layers": None,
     },
     "spre": {"compat": False, "space": None, "channels": None, "skip": 0},
 }
@@ -106,6 +109,7 @@ class QuerySpec:
         spec = cls(kind, text, origin, tuple(sorted(merged.items())))
         if kind != "spre":
             spec_tolerance(spec)
+            spec_choice(spec)
         return spec
 
     @classmethod
@@ -207,18 +211,35 @@ def _spre_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap
     return rows
 
 
+def spec_choice(spec: QuerySpec) -> Any:
+    """The spec's choice for unknown map layers (checked when the spec was made), one object per
+    choice and process, so the road-map geometry built for it serves every trace on the same map."""
+    return _choice_of(spec.option("unknown_layers"))
+
+
+@cache
+def _choice_of(mode: str | None) -> Any:
+    from ..model.layers import UnknownLayers
+
+    return UnknownLayers(mode)
+
+
 def scene_options(spec: QuerySpec) -> Any:
     """The :class:`~scenegrep.scene.SceneOptions` of a scene spec."""
     from ..scene import SceneOptions
 
-    return SceneOptions(spec_tolerance(spec), spec.option("exact"), spec.option("visible_distance"))
+    return SceneOptions(
+        spec_tolerance(spec), spec.option("exact"), spec.option("visible_distance"), unknown_layers=spec_choice(spec)
+    )
 
 
 def scenario_options(spec: QuerySpec) -> Any:
     """The :class:`~scenegrep.scenario.ScenarioOptions` of a scenario spec."""
     from ..scenario import ScenarioOptions
 
-    return ScenarioOptions(spec_tolerance(spec), spec.option("visible_distance"), spec.option("all"))
+    return ScenarioOptions(
+        spec_tolerance(spec), spec.option("visible_distance"), spec.option("all"), unknown_layers=spec_choice(spec)
+    )
 
 
 def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap | None) -> list[dict[str, Any]]:
@@ -242,7 +263,7 @@ def _scenario_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: Roa
     if trace.behaviours is None:
         from ..label import label_trace
 
-        trace = label_trace(trace, road_map).trace
+        trace = label_trace(trace, road_map, unknown_layers=spec_choice(spec)).trace
     result = query.match(trace, spec.option("window"), road_map, scenario_options(spec))
     return scenario_rows(result, spec.option("all"), spec.option("explain"))
 

@@ -10,9 +10,10 @@ trace's own where given, else finite differences of positions.
 Map relations (all absent, i.e. -1/NaN/False, without a map): ``lane`` (index of the map lane
 the object is in, the best-aligned where lanes overlap), ``lane_heading`` (that lane's direction
 at the point), ``lateral`` (smoothed speed across the lane's direction, left positive),
-``in_intersection``, ``on_drivable``, ``in_crossing``, and lane-id changes to a same-direction
-neighbour (``change_left`` / ``change_right``, set at the first observation in the new lane);
-``knows_intersections`` says whether the map has any intersection.
+``in_intersection``, ``on_drivable``, ``in_crossing`` (1.0 or 0.0; NaN, unknown, on a map whose
+format does not publish crosswalks), and lane-id changes to a same-direction neighbour
+(``change_left`` / ``change_right``, set at the first observation in the new lane);
+``knows_intersections`` says whether the map has any intersection; ``map_name`` names the map.
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ class Evidence:
     has_left: np.ndarray
     has_right: np.ndarray
     knows_intersections: bool
+    map_name: str | None
 
 
 def gather(trace: LabelTrace, road_map: RoadMap | None, tracks: Tracks, smooth_s: float) -> Evidence:
@@ -85,6 +87,7 @@ def gather(trace: LabelTrace, road_map: RoadMap | None, tracks: Tracks, smooth_s
         has_right=relations.neighbour(relations.right, relations.lane) >= 0,
         knows_intersections=road_map is not None
         and bool(road_map.intersections or road_map.lane_is_intersection.any()),
+        map_name=None if road_map is None else road_map.name,
     )
 
 
@@ -118,7 +121,10 @@ class _MapRelations:
             return cls(none, np.full(n, np.nan), false, false, false, np.zeros(0, np.intp), np.zeros(0, np.intp))
         pairs = road_map.lanes_containing(x, y)
         lane = road_map.lane_at(x, y, heading, pairs=pairs)
-        crossing = road_map.contains("crossing", x, y) if road_map.crosswalks else np.zeros(n, dtype=bool)
+        if not road_map.publishes("crossing"):
+            crossing = np.full(n, np.nan)
+        else:
+            crossing = road_map.contains("crossing", x, y).astype(float) if road_map.crosswalks else np.zeros(n)
         return cls(
             lane=lane,
             lane_heading=road_map.lane_direction_at(x, y, lane),

@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..model import BehaviourLabels, LabelTrace, RoadMap
+from ..model.layers import UnknownLayers
 from .config import LabelConfig, load_config
 from .evidence import Evidence, gather
 from .rules import VOCABULARY, confidences
@@ -36,14 +37,17 @@ def label_trace(
     road_map: RoadMap | None = None,
     config: LabelConfig | None = None,
     min_confidence: float | None = None,
+    unknown_layers: UnknownLayers | None = None,
 ) -> Labelling:
-    """Label ``trace`` (see the module docstring); ``min_confidence`` overrides the configuration's."""
+    """Label ``trace`` (see the module docstring); ``min_confidence`` overrides the configuration's;
+    ``unknown_layers`` is the user's choice for map layers the map does not publish (see
+    :mod:`.rules`: the crosswalks of the Cross rule)."""
     config = config or load_config()
     threshold = config.labels.min_confidence if min_confidence is None else min_confidence
     tracks = Tracks.of(trace, config.tracks.max_gap_s)
     evidence = gather(trace, road_map, tracks, config.tracks.smooth_s)
     kinds = trace.objects.kinds()[trace.states.object[tracks.order]]
-    scores = confidences(evidence, kinds, tracks, config)
+    scores = confidences(evidence, kinds, tracks, config, unknown_layers)
     member = scores >= max(threshold, np.finfo(float).tiny)
     best = np.argmax(scores, axis=1)
     member[np.arange(len(best)), best] |= ~member.any(axis=1)

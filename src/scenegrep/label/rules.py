@@ -15,7 +15,11 @@ Every confidence is a product of ramps (:data:`~.config.Ramp`) over the evidence
   the object's own heading.
 * pedestrians, cyclists and animals: ``Stationary`` by the speed, ``Walk`` its complement,
   ``Cross`` walking in a crosswalk, or across a lane's direction on it (or anywhere else on the
-  drivable area, reduced).
+  drivable area, reduced). On a map that does not publish crosswalks, an observation whose
+  ``Cross`` confidence depends on whether it is in one (walking, not fully crossing by the lane
+  evidence) is an error unless the user chose how to treat the unknown layer
+  (:class:`~scenegrep.model.layers.UnknownLayers`: in a crosswalk everywhere, or nowhere); those
+  observations are counted as decisions the choice affected.
 * anything else (static objects): ``Stationary`` by the vehicle speed ramp.
 
 A track with no usable speed (a single observation) gets ``[tracks].unknown_confidence`` for
@@ -29,6 +33,7 @@ import numpy as np
 
 from ..model.geometry import heading_difference
 from ..model.taxonomy import VEHICLE_KINDS
+from ..model.layers import UnknownLayers
 from .config import LabelConfig, PedestrianConfig, Ramp, VehicleConfig
 from .evidence import Evidence
 from .tracks import Tracks
@@ -69,8 +74,11 @@ def ramp(values: np.ndarray, bounds: Ramp) -> np.ndarray:
     return np.clip((values - low) / (high - low), 0.0, 1.0)
 
 
-def confidences(evidence: Evidence, kinds: np.ndarray, tracks: Tracks, config: LabelConfig) -> np.ndarray:
-    """(observations, len(VOCABULARY)) confidences in track order; ``kinds`` per observation."""
+def confidences(
+    evidence: Evidence, kinds: np.ndarray, tracks: Tracks, config: LabelConfig, choice: UnknownLayers | None = None
+) -> np.ndarray:
+    """(observations, len(VOCABULARY)) confidences in track order; ``kinds`` per observation;
+    ``choice`` treats an unknown crosswalk layer (None: an error where a decision needs it)."""
     out = np.zeros((len(kinds), len(VOCABULARY)))
     column = {name: k for k, name in enumerate(VOCABULARY)}
     vehicle = np.isin(kinds, list(VEHICLE_KINDS))
@@ -78,7 +86,9 @@ def confidences(evidence: Evidence, kinds: np.ndarray, tracks: Tracks, config: L
     unknown = config.tracks.unknown_confidence
     for name, score in _vehicle(evidence, tracks, config.vehicle, unknown).items():
         out[vehicle, column[name]] = score[vehicle]
-    for name, score in _walking(evidence, config.pedestrian, unknown).items():
+    walks = _walking(evidence, config.pedestrian, unknown)
+    walks["Cross"] = _cross(evidence, walks, walking, config.pedestrian, choice or UnknownLayers())
+    for name, score in walks.items():
         out[walking, column[name]] = score[walking]
     other = ~(vehicle | walking)
     out[other, column["Stationary"]] = _stationary(evidence.speed, config.vehicle.stationary_speed_mps, unknown)[other]
@@ -146,6 +156,27 @@ def _turn_angle(e: Evidence, tracks: Tracks, c: VehicleConfig) -> np.ndarray:
 def _walking(e: Evidence, c: PedestrianConfig, unknown: float) -> dict[str, np.ndarray]:
     stationary = _stationary(e.speed, c.stationary_speed_mps, unknown)
     walk = np.where(np.isnan(e.speed), unknown, 1.0 - stationary)
+    return {"Stationary": stationary, "Walk": walk}
+
+
+def _on_road_cross(e: Evidence, c: PedestrianConfig) -> np.ndarray:
+    """How much walking here is crossing, by the lane evidence alone (in [0, 1])."""
     across = np.arcsin(np.abs(np.sin(heading_difference(e.motion_heading, e.lane_heading))))
-    on_road = np.where(e.lane >= 0, np.nan_to_num(ramp(across, c.cross_angle_rad)), e.on_drivable * c.off_lane_cross)
-    return {"Stationary": stationary, "Walk": walk, "Cross": walk * np.maximum(e.in_crossing, on_road)}
+    return np.where(e.lane >= 0, np.nan_to_num(ramp(across, c.cross_angle_rad)), e.on_drivable * c.off_lane_cross)
+
+
+def _cross(
+    e: Evidence, walks: dict[str, np.ndarray], walking: np.ndarray, c: PedestrianConfig, choice: UnknownLayers
+) -> np.ndarray:
+    """The Cross confidence: walking, in a crosswalk or crossing by the lane evidence. Where the
+    crosswalk layer is unknown, the observations of walking objects whose confidence depends on it
+    take the user's choice (counted), or are an error without one."""
+    walk, on_road = walks["Walk"], _on_road_cross(e, c)
+    unknown = np.isnan(e.in_crossing)
+    depends = unknown & walking & (walk > 0) & (on_road < 1)
+    if depends.any() and choice.mode is None:
+        needed_by = f"the labeller's Cross rule ({int(depends.sum())} observations of walking objects)"
+        raise choice.refuse(["crossing"], needed_by, e.map_name or "?")
+    choice.count("crossing", int(depends.sum()))
+    in_crossing = np.where(unknown, 1.0 if choice.everywhere else 0.0, e.in_crossing)
+    return walk * np.maximum(in_crossing, on_road)

@@ -2,21 +2,25 @@
 
 One row per map element; ``kind`` is lane, road, intersection, crosswalk,
 sidewalk, shoulder, curb or drivable. Geometries are WKB (polygons; a curb is a line
-string); lanes also carry their centreline and topology columns.
+string); lanes also carry their centreline and topology columns. The metadata names the
+layers the map's format does not publish (``unknown_layers``, layout 2); a layout-1 file, written
+before layers were told apart, has every optional layer it holds no element of unknown.
 """
 
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 
 import numpy as np
 import pyarrow as pa
 import shapely
 
-from .roadmap import Area, Lane, LaneNeighbour, RoadMap
+from .roadmap import OPTIONAL_LAYERS, Area, Lane, LaneNeighbour, RoadMap
 
 METADATA_KEY = b"scenegrep-map"
-LAYOUT_VERSION = 1
+LAYOUT_VERSION = 2
+READABLE_LAYOUTS = (1, 2)
 _AREA_KINDS = ("road", "intersection", "crosswalk", "sidewalk", "shoulder")
 _AREA_FIELDS = ("roads", "intersections", "crosswalks", "sidewalks", "shoulders")
 
@@ -75,7 +79,12 @@ def map_to_table(road_map: RoadMap) -> pa.Table:
     if road_map.drivable_area is not None:
         rows.append({"kind": "drivable", "id": "drivable", "geometry": shapely.to_wkb(road_map.drivable_area)})
     table = pa.Table.from_pylist(rows, schema=SCHEMA)
-    meta = {"layout": LAYOUT_VERSION, "name": road_map.name, "source": road_map.source}
+    meta = {
+        "layout": LAYOUT_VERSION,
+        "name": road_map.name,
+        "source": road_map.source,
+        "unknown_layers": sorted(road_map.unknown_layers),
+    }
     return table.replace_schema_metadata({METADATA_KEY: json.dumps(meta).encode()})
 
 
@@ -93,7 +102,7 @@ def map_from_table(table: pa.Table) -> RoadMap:
     if not is_map_table(table.schema):
         raise ValueError("not a scenegrep map table (no scenegrep-map metadata)")
     meta = json.loads(table.schema.metadata[METADATA_KEY])
-    if meta.get("layout") != LAYOUT_VERSION:
+    if meta.get("layout") not in READABLE_LAYOUTS:
         raise ValueError(f"unsupported map layout {meta.get('layout')!r}")
     rows = table.to_pylist()
     geometry = shapely.from_wkb(np.array([r["geometry"] for r in rows], dtype=object))
@@ -124,6 +133,7 @@ def map_from_table(table: pa.Table) -> RoadMap:
         elif kind == "drivable":
             drivable = geom
     road, intersection, crosswalk, sidewalk, shoulder = (tuple(areas[k]) for k in _AREA_KINDS)
+    held = {"crossing": crosswalk, "sidewalk": sidewalk, "curb": curbs, "shoulder": shoulder}
     return RoadMap(
         meta["name"],
         tuple(lanes),
@@ -135,4 +145,15 @@ def map_from_table(table: pa.Table) -> RoadMap:
         drivable,
         meta.get("source"),
         shoulder,
+        _unknown_layers(meta, held),
     )
+
+
+def _unknown_layers(meta: dict, held: dict[str, Sequence]) -> frozenset[str]:
+    """The unknown layers the metadata names; for layout 1, the optional layers without elements."""
+    if meta["layout"] == 1:
+        return frozenset(layer for layer in OPTIONAL_LAYERS if not held[layer])
+    names = meta.get("unknown_layers")
+    if not isinstance(names, list) or not set(names) <= set(OPTIONAL_LAYERS):
+        raise ValueError(f"bad unknown_layers {names!r} in the map metadata")
+    return frozenset(names)

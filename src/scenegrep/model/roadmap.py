@@ -63,12 +63,21 @@ class Area:
 REGION_NAMES = ("lane", "road", "intersection", "crossing", "sidewalk", "drivable")
 """Region names accepted by :meth:`RoadMap.contains`; Scenic's driving-domain names."""
 
+OPTIONAL_LAYERS = ("crossing", "sidewalk", "curb", "shoulder")
+"""Layers a map format may not publish (see :attr:`RoadMap.unknown_layers`); lanes, roads,
+intersections and the drivable area are published by every format."""
+
 
 @dataclass(frozen=True, eq=False)
 class RoadMap:
     """A road network; see the module docstring. ``curbs`` are polylines (k x 2 arrays).
     ``shoulders`` are the road shoulders where a map separates them from the drivable area
-    (OpenDRIVE); a map whose ``drivable_area`` is given includes its shoulders there."""
+    (OpenDRIVE); a map whose ``drivable_area`` is given includes its shoulders there.
+
+    ``unknown_layers`` (a subset of :data:`OPTIONAL_LAYERS`) are the layers the map's format does
+    not publish: their elements are *unknown*, not absent. Every other layer holds exactly the
+    elements given, so a published layer with no elements is *empty*. Readers state it per format;
+    a map built in code publishes every layer."""
 
     name: str
     lanes: tuple[Lane, ...]
@@ -80,6 +89,16 @@ class RoadMap:
     drivable_area: BaseGeometry | None = None
     source: str | None = field(default=None, compare=False)
     shoulders: tuple[Area, ...] = ()
+    unknown_layers: frozenset[str] = frozenset()
+
+    def __post_init__(self) -> None:
+        odd = set(self.unknown_layers) - set(OPTIONAL_LAYERS)
+        if odd:
+            raise ValueError(f"unknown_layers names {sorted(odd)}; only {', '.join(OPTIONAL_LAYERS)} may be unknown")
+
+    def publishes(self, layer: str) -> bool:
+        """Whether the map's format publishes ``layer`` (then its elements here are all there are)."""
+        return layer not in self.unknown_layers
 
     # ------------------------------------------------------------------ lookup tables
     @cached_property
@@ -240,6 +259,8 @@ class RoadMap:
         """Element-by-element equality with exactly equal coordinates."""
         if not isinstance(other, RoadMap) or self.name != other.name:
             return False
+        if self.unknown_layers != other.unknown_layers:
+            return False
         pairs = [
             (self.lanes, other.lanes),
             (self.roads, other.roads),
@@ -282,6 +303,7 @@ class RoadMap:
             drivable,
             self.source,
             near(self.shoulders),
+            self.unknown_layers,
         )
 
 

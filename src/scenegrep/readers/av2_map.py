@@ -27,6 +27,8 @@ from .common import field, read_bytes, reading
 FORMAT = "av2-map"
 _LANE_KINDS = {"VEHICLE": "vehicle", "BIKE": "bike", "BUS": "bus"}
 _RESAMPLE_POINTS = 20
+UNKNOWN_LAYERS = frozenset({"sidewalk", "curb", "shoulder"})
+"""Layers the AV2 map format does not publish (its drivable area includes the shoulders)."""
 
 
 def find_map(directory: Path) -> Path | None:
@@ -124,4 +126,5 @@ def read_map(path: str | Path) -> RoadMap:
         crossings,
         drivable_area=drivable,
         source=str(path),
+        unknown_layers=UNKNOWN_LAYERS,
     )

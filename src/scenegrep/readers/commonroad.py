@@ -56,6 +56,9 @@ from .common import read_bytes
 
 FORMAT = "commonroad"
 ROOT_TAG = "commonRoad"
+UNKNOWN_LAYERS = frozenset({"crossing", "sidewalk", "curb", "shoulder"})
+"""Layers this reader does not publish: it reads lanelets only (not crosswalk or sidewalk lanelets
+as such, nor road boundaries)."""
 MAX_SPEED_SIGN_IDS = frozenset({"R2-1", "274"})
 """Traffic sign ids of a maximum speed (value in m/s): USA (MUTCD R2-1) and Germany/Zamunda (StVO 274)."""
 
@@ -459,4 +462,11 @@ def read_map(path: str | Path) -> RoadMap:
     lanes = [_lane(doc, lanelet, sign_limits) for lanelet in lanelets]
     inside = _intersection_lanelets(doc.root, lanes)
     lanes = [replace(lane, is_intersection=lane.id in inside) for lane in lanes]
-    return RoadMap(_name(doc), tuple(lanes), derive_roads(lanes), derive_intersections(lanes), source=str(path))
+    return RoadMap(
+        _name(doc),
+        tuple(lanes),
+        derive_roads(lanes),
+        derive_intersections(lanes),
+        source=str(path),
+        unknown_layers=UNKNOWN_LAYERS,
+    )

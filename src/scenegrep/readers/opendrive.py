@@ -50,7 +50,10 @@ from .common import reading, regular_file
 from .trace_parquet import read_map as read_cached
 
 FORMAT = "opendrive"
-CONVERSION_VERSION = 3
+UNKNOWN_LAYERS: frozenset[str] = frozenset()
+"""Scenic's road network publishes every layer (crossings, sidewalks, curbs, shoulders), so an
+OpenDRIVE map without, say, sidewalks has an empty sidewalk layer, as in Scenic."""
+CONVERSION_VERSION = 4
 """Bumped whenever the conversion changes, so cached maps are rebuilt."""
 
 
@@ -121,6 +124,7 @@ def convert_network(network: Any, name: str, source: str) -> RoadMap:
         network.drivableRegion.polygons,
         source,
         _areas(network.shoulders),
+        UNKNOWN_LAYERS,
     )
 
 

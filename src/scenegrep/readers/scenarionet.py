@@ -273,5 +273,25 @@ def read_map(path: str | Path, key: str | None = None) -> RoadMap:
     )
     name = str(scenario["metadata"].get("map") or scenario.get("id", path.stem))
     return RoadMap(
-        name, tuple(lanes), derive_roads(lanes), derive_intersections(lanes), crosswalks, (), curbs, source=str(path)
+        name,
+        tuple(lanes),
+        derive_roads(lanes),
+        derive_intersections(lanes),
+        crosswalks,
+        (),
+        curbs,
+        source=str(path),
+        unknown_layers=_unknown_layers(scenario, bool(crosswalks)),
     )
+
+
+CROSSWALK_DATASETS = frozenset({"waymo"})
+"""Source datasets whose ScenarioNet conversion writes their crosswalks (nuScenes' does not)."""
+
+
+def _unknown_layers(scenario: dict[str, Any], has_crosswalks: bool) -> frozenset[str]:
+    """Sidewalks and shoulders are not in the format; crosswalks are published when the file holds
+    some or its source dataset's conversion writes them (see :data:`CROSSWALK_DATASETS`)."""
+    dataset = str(scenario["metadata"].get("dataset", "")).lower()
+    known_crossings = has_crosswalks or dataset in CROSSWALK_DATASETS
+    return frozenset({"sidewalk", "shoulder"} | (set() if known_crossings else {"crossing"}))

@@ -67,6 +67,8 @@ from .tfrecord import read_records, record_location
 
 FORMAT = "waymo-tfrecord"
 
+UNKNOWN_LAYERS = frozenset({"sidewalk", "shoulder"})
+"""Layers a WOMD Scenario does not publish (it has crosswalks and road edges, used as curbs)."""
 MIN_HALF_WIDTH_M = 1.0
 MAX_HALF_WIDTH_M = 3.0
 DEFAULT_HALF_WIDTH_M = 1.8
@@ -402,6 +404,7 @@ def _road_map(scenario: Any, path: str | Path) -> RoadMap:
         crosswalks,
         curbs=tuple(edges.values()),
         source=str(path),
+        unknown_layers=UNKNOWN_LAYERS,
     )
 
 

@@ -19,10 +19,12 @@ import numpy as np
 
 from ..errors import UserError, at
 from ..model import LabelTrace, RoadMap
+from ..model.layers import UnknownLayers
 from ..scene.decide import Tolerance
 from ..scene.dependencies import analyse, completed_groups
 from ..scene.geometry import geometry_of
 from ..scene.match import SceneOptions, labels_of, match_trace
+from ..scene.needs import check_layers
 from ..scene.query import SceneQuery, SceneResult, term_layers
 from ..scene.resolve import Resolver
 from ..scenic.adapter import parse_program
@@ -39,11 +41,14 @@ from .vocabulary import Vocabulary, load_vocabulary
 @dataclass(frozen=True)
 class ScenarioOptions:
     """How to match: tolerances of the initial-scene check and of guards, the visible distance (m)
-    of the initial scene, and whether to find every correspondence and window (``find_all``)."""
+    of the initial scene, whether to find every correspondence and window (``find_all``), and the
+    user's choice for map layers the map does not publish (None: a guard or initial-scene part that
+    needs one is an error)."""
 
     tolerance: Tolerance = field(default_factory=Tolerance)
     visible_distance: float | None = None
     find_all: bool = False
+    unknown_layers: UnknownLayers | None = None
 
 
 @dataclass(frozen=True)
@@ -120,7 +125,9 @@ class ScenarioQuery:
             raise UserError("the trace has no behaviour labels; label it first (scenegrep label)", at(trace.name))
         m = window_frames(window, trace)
         road_map = self.scene.map_for(trace, road_map, self.uses_map())
-        geometry = geometry_of(road_map)
+        geometry = geometry_of(road_map, options.unknown_layers)
+        guards = ((g.condition, f"the guard '{g.text}'", g.span) for g in self.guards)
+        check_layers(self.scene.program, geometry, guards)
         objects = {o.name: o for o in self.scene.program.objects}
         obs = Observations(trace, geometry, self.vocabulary, objects, options.tolerance)
         automata = self.automata(obs.period)
@@ -172,7 +179,12 @@ class ScenarioQuery:
         options = options or ScenarioOptions()
         starts = np.arange(max(trace.n_frames - window_frames(window, trace) + 1, 0))
         road_map = self.scene.map_for(trace, road_map, self.uses_map())
-        scene_options = SceneOptions(options.tolerance, visible_distance=options.visible_distance, frames=starts)
+        scene_options = SceneOptions(
+            options.tolerance,
+            visible_distance=options.visible_distance,
+            frames=starts,
+            unknown_layers=options.unknown_layers,
+        )
         return self.scene.match(trace, road_map, scene_options), starts
 
 

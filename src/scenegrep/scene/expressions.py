@@ -218,7 +218,7 @@ def _attribute(r: Resolver, node: ir.Attribute) -> Any:
     if isinstance(value, Namespace):
         if node.attr not in value.attributes:
             raise r.error(f"{value.name} has no attribute {node.attr!r}", node)
-        return r.note_layers(value.attributes[node.attr])
+        return value.attributes[node.attr]
     if isinstance(value, Vec) and node.attr in ("x", "y"):
         return value.x if node.attr == "x" else value.y
     if isinstance(value, Instance):

@@ -16,13 +16,13 @@ parameters for the same rows:
   direction (on road or shoulder areas outside lanes, where Scenic uses that
   element's own orientation).
 
-Layers a map does not hold (sidewalks, crossings, curbs and shoulders may be
-missing; a map that gives its drivable area explicitly, as AV2 does, holds its
-shoulders there, so its shoulder layer is known to be empty) are *unknown*: a
-point or box may lie in them anywhere and nothing is proved to lie outside them,
-so the class defaults that name them (a pedestrian's walkable region, a car's
-road-or-shoulder) constrain nothing on such a map. A program that names a missing layer itself is an error
-(:meth:`MapGeometry.missing_layers` lets the caller say so).
+Layers the map's format does not publish (:attr:`~scenegrep.model.RoadMap.unknown_layers`)
+are *unknown*; a layer it publishes with no elements is empty. Every public query first reduces
+the region (:func:`.unknown.reduced`: on a map that gives its drivable area but no shoulders, the
+shoulders lie in the drivable area), then, when the region still reads an unknown layer, applies
+the user's choice (:class:`~scenegrep.model.layers.UnknownLayers`): without one it is an error
+naming the layer; with one the layer is everywhere (permissive) or empty (strict), and the rows
+whose answer differs under the other assumption are counted as decisions the assumption affected.
 """
 
 from __future__ import annotations
@@ -39,6 +39,7 @@ from shapely import STRtree
 from ..errors import UserError
 from ..model import RoadMap
 from ..model.geometry import box_corners
+from ..model.layers import UnknownLayers
 from . import shapes
 from .regions import (
     Difference,
@@ -55,6 +56,7 @@ from .regions import (
     Union,
 )
 from .terms import Term
+from .unknown import assumed, needed, reduced
 
 Values = Callable[[Term], np.ndarray]
 
@@ -64,45 +66,64 @@ CURB_REACH_M = 1e-6
 GEOMETRY_CACHE_SIZE = 8
 """How many road maps' geometries :func:`geometry_of` keeps (least recently used dropped)."""
 
-OPTIONAL_LAYERS = ("sidewalk", "crossing", "curb", "shoulder")
-"""Layers some maps lack; lanes, the drivable area, roads and intersections are always known."""
 
-
-def geometry_of(road_map: RoadMap | None) -> MapGeometry:
-    """The :class:`MapGeometry` of ``road_map``, shared by every query over the same map object
-    (its layer unions and region geometries are built once, on first use); the last
-    :data:`GEOMETRY_CACHE_SIZE` maps are kept."""
+def geometry_of(road_map: RoadMap | None, unknown_layers: UnknownLayers | None = None) -> MapGeometry:
+    """The :class:`MapGeometry` of ``road_map`` under the choice ``unknown_layers`` (None: no
+    choice), shared by every query over the same map object and choice (its layer unions and
+    region geometries are built once, on first use); the last :data:`GEOMETRY_CACHE_SIZE` are kept."""
     if road_map is None:
-        return MapGeometry(None)
-    geometry = _GEOMETRIES.pop(id(road_map), None)
+        return MapGeometry(None, unknown_layers)
+    key = (id(road_map), id(unknown_layers))
+    geometry = _GEOMETRIES.pop(key, None)
     if geometry is None:
-        geometry = MapGeometry(road_map)
-    _GEOMETRIES[id(road_map)] = geometry
+        geometry = MapGeometry(road_map, unknown_layers)
+    _GEOMETRIES[key] = geometry
     while len(_GEOMETRIES) > GEOMETRY_CACHE_SIZE:
         _GEOMETRIES.popitem(last=False)
     return geometry
 
 
 class MapGeometry:
-    """Geometric queries over one road map (or none: only map-free regions then)."""
+    """Geometric queries over one road map (or none: only map-free regions then), under a choice
+    for its unknown layers (see the module docstring)."""
 
-    def __init__(self, road_map: RoadMap | None):
+    def __init__(self, road_map: RoadMap | None, unknown_layers: UnknownLayers | None = None):
         self.map = road_map
-        self.unknown = self.missing_layers(set(OPTIONAL_LAYERS)) if road_map is not None else set()
+        self.choice = unknown_layers or UnknownLayers()
+        self.unknown = set(road_map.unknown_layers) if road_map is not None else set()
+        self._shoulders_in_drivable = (
+            road_map is not None and road_map.drivable_area is not None and not road_map.publishes("shoulder")
+        )
         self._static: dict[Region, shapely.Geometry | None] = {}
 
     # ---------------------------------------------------------------- layers
-    def missing_layers(self, layers: set[str]) -> set[str]:
-        """The layers among ``layers`` the map does not hold."""
-        if self.map is None:
-            return set(layers)
-        present = {
-            "sidewalk": bool(self.map.sidewalks),
-            "crossing": bool(self.map.crosswalks),
-            "curb": bool(self.map.curbs),
-            "shoulder": bool(self.map.shoulders) or self.map.drivable_area is not None,
-        }
-        return {layer for layer in layers if not present.get(layer, True)}
+    def unknown_needed(self, region: Region) -> set[str]:
+        """The unknown layers a decision about ``region`` needs on this map."""
+        return needed(reduced(region, self._shoulders_in_drivable), self.unknown)
+
+    def _decided(self, region: Region, decide: Callable[[Region], np.ndarray]) -> np.ndarray:
+        """``decide(region)`` with the unknown layers it needs replaced as the user chose; counts
+        the rows whose answer the choice decided; an error naming the layer without a choice."""
+        region = reduced(region, self._shoulders_in_drivable)
+        layers = needed(region, self.unknown)
+        if not layers:
+            return decide(region)
+        chosen = decide(self._assumed(region, layers))
+        other = decide(assumed(region, layers, not self.choice.everywhere))
+        self.choice.count("+".join(sorted(layers)), np.count_nonzero(chosen != other))
+        return chosen
+
+    def _assumed(self, region: Region, layers: set[str]) -> Region:
+        if self.choice.mode is None:
+            name = self.map.name if self.map is not None else "?"
+            raise self.choice.refuse(layers, "a region of the query", name)
+        return assumed(region, layers, self.choice.everywhere)
+
+    def _known(self, region: Region) -> Region:
+        """``region`` reduced, with its unknown layers replaced as the user chose (not counted)."""
+        region = reduced(region, self._shoulders_in_drivable)
+        layers = needed(region, self.unknown)
+        return self._assumed(region, layers) if layers else region
 
     def _require_map(self) -> RoadMap:
         if self.map is None:
@@ -157,13 +178,14 @@ class MapGeometry:
         Exact for map layers and degenerate boxes (points); for sectors and combinations of
         regions it may say True for a box that misses the region by at most its diagonal.
         """
+        return self._decided(region, lambda r: self._boxes_meet(r, x_lo, x_hi, y_lo, y_hi, value))
+
+    def _boxes_meet(self, region: Region, x_lo, x_hi, y_lo, y_hi, value: Values) -> np.ndarray:
         n = len(x_lo)
         if isinstance(region, Everywhere):
             return np.ones(n, dtype=bool)
         if isinstance(region, Nowhere):
             return np.zeros(n, dtype=bool)
-        if isinstance(region, MapRegion) and region.layer in self.unknown:
-            return np.ones(n, dtype=bool)
         if isinstance(region, MapRegion):
             boxes = shapely.box(x_lo, y_lo, x_hi, y_hi)
             if region.layer == "curb":
@@ -178,22 +200,22 @@ class MapGeometry:
         if isinstance(region, Intersection):
             hit = np.ones(n, dtype=bool)
             for part in region.parts:
-                hit &= self.boxes_meet(part, x_lo, x_hi, y_lo, y_hi, value)
+                hit &= self._boxes_meet(part, x_lo, x_hi, y_lo, y_hi, value)
             return hit
         if isinstance(region, Union):
             hit = np.zeros(n, dtype=bool)
             for part in region.parts:
-                hit |= self.boxes_meet(part, x_lo, x_hi, y_lo, y_hi, value)
+                hit |= self._boxes_meet(part, x_lo, x_hi, y_lo, y_hi, value)
             return hit
         if isinstance(region, Difference):
             inside_removed = self._aligned_boxes_inside(region.removed, x_lo, x_hi, y_lo, y_hi, value)
-            return self.boxes_meet(region.base, x_lo, x_hi, y_lo, y_hi, value) & ~inside_removed
+            return self._boxes_meet(region.base, x_lo, x_hi, y_lo, y_hi, value) & ~inside_removed
         raise TypeError(f"unknown region {region!r}")
 
     def _aligned_boxes_inside(self, region: Region, x_lo, x_hi, y_lo, y_hi, value: Values) -> np.ndarray:
         """Whether each axis-aligned box lies wholly inside the region (used to exclude boxes)."""
         x, y = (x_lo + x_hi) / 2, (y_lo + y_hi) / 2
-        return self.contains_boxes(region, x, y, np.zeros_like(x), y_hi - y_lo, x_hi - x_lo, value)
+        return self._contains_boxes(region, x, y, np.zeros_like(x), y_hi - y_lo, x_hi - x_lo, value)
 
     def _boxes_meet_lane_of(self, x_lo, x_hi, y_lo, y_hi, ax, ay) -> np.ndarray:
         road_map = self._require_map()
@@ -205,6 +227,7 @@ class MapGeometry:
 
     def region_bounds(self, region: Region, value: Values) -> tuple[float, float, float, float] | None:
         """(min x, min y, max x, max y) enclosing the region (one row of its parameters), None if empty."""
+        region = self._known(region)
         if isinstance(region, Nowhere):
             return None
         if isinstance(region, Everywhere):
@@ -241,15 +264,15 @@ class MapGeometry:
         """The region as one (prepared) shapely geometry when it is made of known map layers only,
         else None; computed once per region."""
         if region not in self._static:
-            geometry = self._static_geometry(region)
+            geometry = self._static_geometry(self._known(region))
             if geometry is not None:
                 shapely.prepare(geometry)
             self._static[region] = geometry
         return self._static[region]
 
     def _static_geometry(self, region: Region) -> shapely.Geometry | None:
-        if isinstance(region, MapRegion) and region.layer in self.unknown:
-            return None
+        if isinstance(region, Nowhere):
+            return shapely.GeometryCollection()
         if isinstance(region, MapRegion):
             self._require_map()
             return self._unions[region.layer]
@@ -266,12 +289,11 @@ class MapGeometry:
     # ---------------------------------------------------------------- oriented boxes
     def contains_boxes(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         """Whether each oriented box lies inside the region (Scenic's ``containsObject``)."""
+        return self._decided(region, lambda r: self._contains_boxes(r, x, y, heading, length, width, value))
+
+    def _contains_boxes(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         n = len(np.atleast_1d(x))
-        if (
-            isinstance(region, Everywhere)
-            or self.unknown.intersection(region.layers())
-            and isinstance(region, (MapRegion, Union))
-        ):
+        if isinstance(region, Everywhere):
             return np.ones(n, dtype=bool)
         if isinstance(region, Nowhere):
             return np.zeros(n, dtype=bool)
@@ -280,11 +302,11 @@ class MapGeometry:
         if isinstance(region, Intersection):
             inside = np.ones(n, dtype=bool)
             for part in region.parts:
-                inside &= self.contains_boxes(part, x, y, heading, length, width, value)
+                inside &= self._contains_boxes(part, x, y, heading, length, width, value)
             return inside
         if isinstance(region, Difference):
-            base = self.contains_boxes(region.base, x, y, heading, length, width, value)
-            return base & ~self.boxes_meet_oriented(region.removed, x, y, heading, length, width, value)
+            base = self._contains_boxes(region.base, x, y, heading, length, width, value)
+            return base & ~self._boxes_meet_oriented(region.removed, x, y, heading, length, width, value)
         polygons = _box_polygons(x, y, heading, length, width)
         if isinstance(region, LaneAt):
             road_map = self._require_map()
@@ -296,6 +318,9 @@ class MapGeometry:
 
     def boxes_meet_oriented(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         """Whether each oriented box intersects the region (touching counts)."""
+        return self._decided(region, lambda r: self._boxes_meet_oriented(r, x, y, heading, length, width, value))
+
+    def _boxes_meet_oriented(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         n = len(np.atleast_1d(x))
         if isinstance(region, Everywhere):
             return np.ones(n, dtype=bool)
@@ -306,10 +331,8 @@ class MapGeometry:
         if isinstance(region, Union):
             hit = np.zeros(n, dtype=bool)
             for part in region.parts:
-                hit |= self.boxes_meet_oriented(part, x, y, heading, length, width, value)
+                hit |= self._boxes_meet_oriented(part, x, y, heading, length, width, value)
             return hit
-        if isinstance(region, MapRegion) and region.layer in self.unknown:
-            return np.ones(n, dtype=bool)
         if isinstance(region, MapRegion):
             return self._layer_hits(region.layer, _box_polygons(x, y, heading, length, width), "intersects")
         raise UserError(f"testing whether an object meets {_describe(region)} is not supported")
@@ -323,11 +346,21 @@ class MapGeometry:
 
     # ---------------------------------------------------------------- distances and fields
     def distances(self, region: Region, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """Distance (m) from each point to the region (0 inside)."""
+        """Distance (m) from each point to the region (0 inside; infinite to an empty region)."""
+        return self._decided(region, lambda r: self._distances(r, x, y))
+
+    def _distances(self, region: Region, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        if isinstance(region, (Everywhere, Nowhere)):
+            return np.full(len(np.atleast_1d(x)), 0.0 if isinstance(region, Everywhere) else np.inf)
         if isinstance(region, MapRegion):
-            return shapely.distance(self._unions[region.layer], shapely.points(x, y))
+            union = self._unions[region.layer]
+            return (
+                np.full(len(np.atleast_1d(x)), np.inf)
+                if union.is_empty
+                else shapely.distance(union, shapely.points(x, y))
+            )
         if isinstance(region, Union) and all(isinstance(p, MapRegion) for p in region.parts):
-            return np.min([self.distances(p, x, y) for p in region.parts], axis=0)
+            return np.min([self._distances(p, x, y) for p in region.parts], axis=0)
         raise UserError(f"the distance to {_describe(region)} is not supported")
 
     def field_values(self, field: Field, x: np.ndarray, y: np.ndarray, value: Values) -> tuple[np.ndarray, np.ndarray]:

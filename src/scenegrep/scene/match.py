@@ -25,6 +25,7 @@ import numpy as np
 
 from ..model import LabelTrace
 from ..model.kinematics import ESTIMATED_VELOCITY
+from ..model.layers import UnknownLayers
 from .decide import Tolerance, decide
 from .dependencies import Group
 from .evaluate import Evaluator, Labels, Rows
@@ -36,13 +37,16 @@ from .program import ProgramObject, SceneProgram
 class SceneOptions:
     """How to match: tolerances, ``exact`` (surjective correspondence), visible distance (m), a
     known (partial) correspondence, program object -> label object id, to check instead of search,
-    and the frame positions to check (None: all; the others are reported as not matching)."""
+    and the frame positions to check (None: all; the others are reported as not matching);
+    ``unknown_layers`` is the user's choice for map layers the map does not publish (None: none,
+    a query that needs one is an error)."""
 
     tolerance: Tolerance = field(default_factory=Tolerance)
     exact: bool = False
     visible_distance: float | None = None
     correspondence: dict[str, str] | None = None
     frames: np.ndarray | None = None
+    unknown_layers: UnknownLayers | None = None
 
 
 @dataclass

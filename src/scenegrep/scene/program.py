@@ -74,7 +74,8 @@ class Requirement:
     """A boolean term that must hold: a ``require`` (soft when its probability is below 1: reported,
     not enforced), an implicit requirement of Scenic (containment, visibility, no collision), or a
     global parameter's value matching the trace attribute of the same name (``parameter``; checked
-    only for traces that have that attribute)."""
+    only for traces that have that attribute). ``container_of`` names the object whose containment
+    in its ``regionContainedIn`` an implicit requirement states."""
 
     condition: Term
     description: str
@@ -82,6 +83,7 @@ class Requirement:
     probability: float | None = None
     implicit: bool = False
     parameter: str | None = None
+    container_of: str | None = None
 
     @property
     def soft(self) -> bool:
@@ -92,15 +94,13 @@ class Requirement:
 class SceneProgram:
     """A resolved program: scene objects in creation order, requirements, global parameters
     (name -> defining term; compared with a trace attribute of the same name when present),
-    the ``param map`` path if any, the map layers the program's own text names, and the term
-    factory that built it all."""
+    the ``param map`` path if any, and the term factory that built it all."""
 
     program: ir.Program
     objects: list[ProgramObject] = field(default_factory=list)
     requirements: list[Requirement] = field(default_factory=list)
     params: dict[str, Term] = field(default_factory=dict)
     map_path: str | None = None
-    explicit_layers: set[str] = field(default_factory=set)
     factory: TermFactory = field(default_factory=TermFactory)
 
     def object(self, name: str) -> ProgramObject:

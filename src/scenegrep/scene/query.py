@@ -27,10 +27,11 @@ from .dependencies import Group, analyse
 from .geometry import MapGeometry, geometry_of
 from .evaluate import Labels
 from .explain import soft_requirements, witness_values
+from .needs import check_layers, term_regions
 from .match import SceneOptions, TraceMatches, labels_of, match_trace
 from .program import Requirement, SceneProgram
 from .resolve import Resolver
-from .terms import Term, value_terms
+from .terms import Term
 
 
 @dataclass
@@ -119,14 +120,8 @@ class SceneQuery:
         """Match every frame of ``trace`` (see :mod:`.match`)."""
         options = options or SceneOptions()
         road_map = self._map_for(trace, road_map)
-        geometry = geometry_of(road_map)
-        missing = geometry.missing_layers(self.program.explicit_layers) if road_map is not None else set()
-        if missing:
-            names = ", ".join(sorted(missing))
-            raise UserError(
-                f"the program names map layers the road map of trace {trace.name!r} does not have: {names}",
-                at(self.program.program.filename),
-            )
+        geometry = geometry_of(road_map, options.unknown_layers)
+        check_layers(self.program, geometry)
         groups = self.groups_for(trace)
         matches = match_trace(self.program, groups, trace, geometry, options)
         return SceneResult(trace, self, matches, labels_of(trace), geometry, options)
@@ -161,22 +156,8 @@ class SceneQuery:
 
 
 def term_layers(term: Term) -> set[str]:
-    """The map layers a term reads, through its regions, fields and random points."""
-    layers: set[str] = set()
-    seen: set[int] = set()
-    stack = [term]
-    while stack:
-        node = stack.pop()
-        if id(node) in seen:
-            continue
-        seen.add(id(node))
-        value = node.value[0].region if node.op == "point" else node.value
-        for item in value if isinstance(value, tuple) else (value,):
-            if hasattr(item, "layers"):
-                layers |= set(item.layers())
-            stack.extend(value_terms(item))
-        stack.extend(node.args)
-    return layers
+    """The map layers a term reads, through its regions and random points."""
+    return {layer for region in term_regions(term) for layer in region.layers()}
 
 
 def _layers(program: SceneProgram) -> set[str]:

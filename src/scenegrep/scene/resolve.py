@@ -204,7 +204,7 @@ class Resolver:
         if node.id == "ego":
             raise self.error("ego is used before it is defined", node)
         if node.id in DRIVING_NAMES:
-            return self.note_layers(DRIVING_NAMES[node.id])
+            return DRIVING_NAMES[node.id]
         if node.id == "network":
             return Namespace("network", NETWORK)
         if node.id == "globalParameters":
@@ -212,13 +212,6 @@ class Resolver:
         if node.id in ("pi", "tau"):
             return self.f.const(math.pi if node.id == "pi" else math.tau)
         raise self.error(f"unknown name {node.id!r}", node)
-
-    def note_layers(self, value: Any) -> Any:
-        """Record the map layers a region named in the program's own text reads (class defaults
-        are not recorded: a layer a map lacks is an error only where the program names it)."""
-        if not self.program.filename.startswith("<default ") and hasattr(value, "layers"):
-            self.scene.explicit_layers.update(value.layers())
-        return value
 
     def label(self, node: ir.Node) -> str:
         """How a random value is named in explanations: its source text and place, ``Range(4, 10)@2:36``."""

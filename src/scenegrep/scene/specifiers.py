@@ -240,7 +240,7 @@ def _add_implicit_requirements(r: Resolver, obj: Instance, modifiers: list[Effec
     container = obj.defining.get("regionContainedIn")
     if isinstance(container, Region) and not isinstance(container, Everywhere):
         term = r.f.op("box_in_region", *box, E.EXACT(r), value=container, kind="bool")
-        _implicit(r, term, f"{obj.name} lies inside its regionContainedIn", node)
+        _implicit(r, term, f"{obj.name} lies inside its regionContainedIn", node, container_of=obj.name)
     require_visible = obj.defining.get("requireVisible")
     if obj.name != "ego" and isinstance(require_visible, Term) and require_visible.value is not False:
         ego = r.scope.get("ego")
@@ -266,9 +266,13 @@ def _add_implicit_requirements(r: Resolver, obj: Instance, modifiers: list[Effec
         _implicit(r, inside, f"{obj.name}'s position lies in the region of 'on'", effect.node)
 
 
-def _implicit(r: Resolver, term: Term, description: str, where: ir.Node | ir.Span) -> None:
+def _implicit(
+    r: Resolver, term: Term, description: str, where: ir.Node | ir.Span, container_of: str | None = None
+) -> None:
     span = where if isinstance(where, ir.Span) else where.span
-    r.scene.requirements.append(Requirement(eased(r.f, term), description, span, implicit=True))
+    r.scene.requirements.append(
+        Requirement(eased(r.f, term), description, span, implicit=True, container_of=container_of)
+    )
 
 
 def add_collision_requirements(r: Resolver) -> None:

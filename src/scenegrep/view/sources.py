@@ -78,7 +78,8 @@ class ResultsSource:
         rows = self.rows_of(trace_id)
         if not rows:
             raise UserError(f"the results have no trace {trace_id!r}")
-        return read_queried_trace(rows[0]["source"], trace_id)
+        choice = self.query.options.get("unknown_layers") if self.query is not None else None
+        return read_queried_trace(rows[0]["source"], trace_id, unknown_layers=choice)
 
     def object_kinds(self, trace_ids: set[str]) -> dict[tuple[str, str], str]:
         """(trace_id, object_id) -> canonical kind, for the given traces."""

@@ -29,6 +29,7 @@ def test_info_text_names_the_facts(real_data, capsys):
     out = capsys.readouterr().out
     assert "156 frames, 15.50 s at 10.0 Hz, 115 objects, ego ego" in out
     assert "183 lanes (73 in intersections)" in out
+    assert "0 curbs; unknown (not published): curb, shoulder, sidewalk;" in out  # AV2 maps
 
 
 def _truncate(source, target):

@@ -55,7 +55,8 @@ def trace_summary(trace: LabelTrace) -> dict[str, Any]:
 
 
 def map_summary(road_map: RoadMap) -> dict[str, Any]:
-    """Counts of a map's elements and its extent in metres."""
+    """Counts of a map's elements, the layers its format does not publish (unknown, not empty) and
+    its extent in metres."""
     min_x, min_y, max_x, max_y = road_map.bounds() if road_map.lanes else (0.0, 0.0, 0.0, 0.0)
     return {
         "name": road_map.name,
@@ -66,6 +67,7 @@ def map_summary(road_map: RoadMap) -> dict[str, Any]:
         "crosswalks": len(road_map.crosswalks),
         "sidewalks": len(road_map.sidewalks),
         "curbs": len(road_map.curbs),
+        "unknown_layers": sorted(road_map.unknown_layers),
         "extent_m": [round(max_x - min_x, 1), round(max_y - min_y, 1)],
     }
 

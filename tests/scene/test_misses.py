@@ -115,9 +115,11 @@ def test_rounding_gives_four_digits_on_the_asked_side(value, up):
 @pytest.mark.real_data
 def test_nuscenes_suggestion_makes_the_frame_match(real_data, capsys):
     """fig3 on nuScenes scene-0061 matches nothing with exact tolerances; the options the nearest
-    miss suggests make its frame match, with the correspondence it names."""
+    miss suggests make its frame match, with the correspondence it names. nuScenes publishes no
+    shoulders, which the cars' default container reads: taken as anywhere."""
     trace = real_data / "nuscenes_mini_scenarionet" / "sd_nuscenes_v1.0-mini_scene-0061.pkl"
     base = ["scene", "examples/scenes/fig3_car_ahead.scenic", str(trace), "--visible-distance", "50"]
+    base += ["--unknown-layers", "permissive"]
     assert main(base) == 1
     err = capsys.readouterr().err
     found = re.search(
@@ -134,13 +136,15 @@ def test_nuscenes_suggestion_makes_the_frame_match(real_data, capsys):
 @pytest.mark.real_data
 def test_scenario_miss_of_the_initial_scene_is_admitted_by_its_suggestion(real_data, capsys):
     """fig1 on nuScenes scene-0061 (3 s windows) matches nothing; the nearest miss of its initial
-    scene names a window start that the suggested tolerances make an initial scene."""
+    scene names a window start that the suggested tolerances make an initial scene (nuScenes'
+    unknown shoulders and crosswalks taken as anywhere)."""
     from scenegrep import readers
+    from scenegrep.model.layers import UnknownLayers
     from scenegrep.scenario import ScenarioOptions, load_scenario
 
     path = real_data / "nuscenes_mini_scenarionet" / "sd_nuscenes_v1.0-mini_scene-0061.pkl"
     program = "examples/queries/fig1_lane_change.scenic"
-    assert main(["scenario", program, str(path), "--window", "3s"]) == 1
+    assert main(["scenario", program, str(path), "--window", "3s", "--unknown-layers", "permissive"]) == 1
     err = capsys.readouterr().err
     found = re.search(r"nearest miss of the initial scene: \S+ frame (\d+) .*\((--tolerance.*) would admit it\)", err)
     assert found, err
@@ -148,7 +152,8 @@ def test_scenario_miss_of_the_initial_scene_is_admitted_by_its_suggestion(real_d
     tolerance = Tolerance(**{options[k][len("--tolerance-") :]: float(options[k + 1]) for k in (0, len(options) - 2)})
     trace = next(iter(readers.read_traces(path)))
     query = load_scenario(program)
-    result, starts = query.initial_scene(trace, "3s", None, ScenarioOptions(tolerance))
-    exact, _ = query.initial_scene(trace, "3s")
+    anywhere = UnknownLayers("permissive")
+    result, starts = query.initial_scene(trace, "3s", None, ScenarioOptions(tolerance, unknown_layers=anywhere))
+    exact, _ = query.initial_scene(trace, "3s", None, ScenarioOptions(unknown_layers=anywhere))
     frame = int(np.flatnonzero(trace.frame_index == int(found[1]))[0])
     assert frame in starts and result.matched[frame] and not exact.matched.any()

@@ -26,6 +26,7 @@ from hypothesis import strategies as st
 
 from scenegrep.errors import UserError
 from scenegrep.model import Area, Lane, RoadMap
+from scenegrep.model.layers import UnknownLayers
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
 from scenegrep.scene.follow_pieces import follow_pieces
 from scenegrep.scene.geometry import MapGeometry
@@ -54,10 +55,12 @@ def curved_map() -> RoadMap:
         _lane("x", crossing, intersection=True),
     )
     area = Area("i", shapely.box(48.25, 58.25, 51.75, 61.75), ("x",))
-    return RoadMap("curved", lanes, roads=(), intersections=(area,))
+    return RoadMap("curved", lanes, roads=(), intersections=(area,), unknown_layers=frozenset({"shoulder"}))
 
 
 MAP = curved_map()
+ANYWHERE = UnknownLayers("permissive")
+"""The map models no shoulders: the cars' default road-or-shoulder constrains nothing here."""
 GEOMETRY = MapGeometry(MAP)
 
 
@@ -84,7 +87,8 @@ def match(x: float, y: float, lo: float, hi: float, label: tuple[float, float, f
     query = compile_scene(HEADER + PROGRAM.format(lo=lo, hi=hi), "follow.scenic")
     ego_heading = end_heading(x, y)
     trace = trace_of({"ego": ("Car", x, y, ego_heading), "c": ("Car", *label)})
-    result = query.match(trace, MAP, SceneOptions(Tolerance(tol, tol), correspondence={"c": "c"}))
+    options = SceneOptions(Tolerance(tol, tol), correspondence={"c": "c"}, unknown_layers=ANYWHERE)
+    result = query.match(trace, MAP, options)
     if not result.matched[0]:
         return False, None
     return True, next(v for k, v in result.values(0).items() if k.startswith("Range"))

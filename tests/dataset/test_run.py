@@ -123,7 +123,19 @@ def cli(*args: str) -> list[str]:
 
 
 def scenario_command(root: Path, *extra: str) -> list[str]:
-    return cli("scenario", str(SCENARIO), "--window", "75", "--dataset", str(root), "-j", "1", *extra)
+    return cli(
+        "scenario",
+        str(SCENARIO),
+        "--window",
+        "75",
+        "--dataset",
+        str(root),
+        "-j",
+        "1",
+        "--unknown-layers",
+        UNKNOWN,
+        *extra,
+    )
 
 
 def copy_of(real_dataset: Path, tmp_path: Path) -> Path:
@@ -264,7 +276,11 @@ def test_user_errors_are_one_line(tmp_path: Path):
 
 def test_window_in_seconds_prunes_and_matches_as_frames(real_dataset: Path):
     frames = run_query(real_dataset, specs()["scenario"], RunOptions(jobs=2)).to_arrow()
-    seconds = run_query(real_dataset, QuerySpec.from_file("scenario", SCENARIO, window="7.5s"), RunOptions(jobs=2))
+    seconds = run_query(
+        real_dataset,
+        QuerySpec.from_file("scenario", SCENARIO, window="7.5s", unknown_layers=UNKNOWN),
+        RunOptions(jobs=2),
+    )
     assert seconds.to_arrow().drop_columns(["explanation"]).equals(frames.drop_columns(["explanation"]))
     assert seconds.counts()["pruned"] == 15
 

@@ -42,7 +42,9 @@ WALKABLE_MAP = dataclasses.replace(
     MAP,
     sidewalks=(Area("w", shapely.box(-6, 0, -3.5, 100)),),
     shoulders=(Area("h", shapely.box(7, 0, 9.5, 100)),),
+    unknown_layers=frozenset(),
 )
+"""The synthetic map with sidewalks and shoulders, publishing every layer."""
 
 
 @cache

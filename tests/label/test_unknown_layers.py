@@ -69,3 +69,26 @@ def test_a_vehicle_only_trace_needs_no_choice():
     trace = walker()
     trace = replace(trace, objects=ObjectTable.build(["car"], ["car"]))
     assert label_trace(trace, UNKNOWN).trace.behaviours is not None
+
+
+@pytest.mark.real_data
+def test_label_cli_refuses_nuscenes_without_a_choice_and_reports_one(real_data, tmp_path, capsys):
+    """nuScenes publishes no crosswalks and scene-0061 has walking pedestrians: an error naming the
+    input and the layer; with a choice, the count of decisions it affected, the same either way and
+    at most the pedestrians' and cyclists' observations."""
+    from scenegrep.cli.main import main
+    from scenegrep.readers import read_trace
+
+    path = real_data / "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl"
+    assert main(["label", str(path), "-o", str(tmp_path), "-q"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"scenegrep: error: {path}: the road map 'singapore-onenorth' does")
+    counts = []
+    for mode in ("strict", "permissive"):
+        assert main(["label", str(path), "-o", str(tmp_path), "-q", "--unknown-layers", mode]) == 0
+        last = capsys.readouterr().err.splitlines()[-1]
+        assert last.startswith(f"scenegrep: --unknown-layers {mode}: unknown map layers taken as ")
+        counts.append(int(last.rsplit("crossing ", 1)[1]))
+    trace = read_trace(path)
+    walking = np.isin(trace.objects.kinds()[trace.states.object], ["pedestrian", "bicycle", "animal"]).sum()
+    assert counts[0] == counts[1] and 0 < counts[0] <= walking

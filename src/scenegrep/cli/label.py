@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from .. import readers
-    from ..errors import UserError
+    from ..errors import UserError, at
     from ..label import label_trace, load_config
     from ..label.statistics import LabelStatistics
     from ..writers import write_trace_parquet
@@ -61,7 +61,10 @@ def run(args: argparse.Namespace) -> int:
         for path in args.data:
             for trace in readers.read_traces(path):
                 road_map = fixed_map or (readers.read_map(trace.map_source) if trace.map_source else None)
-                labelled = label_trace(trace, road_map, config, args.min_confidence, choice).trace
+                try:
+                    labelled = label_trace(trace, road_map, config, args.min_confidence, choice).trace
+                except UserError as exc:  # name the input where the labeller could not
+                    raise exc if exc.location else UserError(exc.message, at(path)) from None
                 write_trace_parquet(labelled, output / f"{_unique(trace.name, names)}.parquet")
                 statistics.add(labelled)
                 progress.update()

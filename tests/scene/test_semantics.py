@@ -338,3 +338,9 @@ def test_choice_counts_the_decisions_it_affected():
     assert matches(program, *frames, unknown_layers=choice) == [True, True]
     assert choice.decisions["sidewalk"] >= 1
     assert "decisions affected: sidewalk" in choice.report()
+    # a car's road-or-shoulder: only a box reaching off the lanes (x -4..-2; lanes start at -3.5) needs
+    # the unknown shoulders; one across two lanes (x -0.5..1.5) does not
+    choice = UnknownLayers("strict")
+    frames = ({"ego": ("Car", -3.0, 20.0, NORTH)}, {"ego": ("Car", 0.5, 20.0, NORTH)})
+    assert matches("ego = new Car on road, facing 0", *frames, unknown_layers=choice) == [False, True]
+    assert choice.decisions == {"shoulder": 1}

@@ -32,8 +32,17 @@ QUERIES = {
         "0.5",
         "--tolerance-heading",
         "0.1",
+        "--unknown-layers",
+        "strict",
     ],
-    "scenario": ["scenario", "examples/queries/s1_lane_change_stationary_car.scenic", "--window", "75"],
+    "scenario": [
+        "scenario",
+        "examples/queries/s1_lane_change_stationary_car.scenic",
+        "--window",
+        "75",
+        "--unknown-layers",
+        "strict",
+    ],
     "spre": ["spre", "[[:pedestrian:]][[:bicycle:]]"],
 }
 FIG1 = "examples/queries/fig1_lane_change.scenic"

@@ -113,3 +113,22 @@ def test_s4_answers_on_real_data_over_the_default_budget(real_data, source, wind
     assert time.perf_counter() - began < 20
     assert any(automaton.over_budget for automaton in query._automata.values())
     assert [a for a, _ in answers][:1] == ([expected] if expected else [])
+
+
+def test_step_tables_over_their_cell_budget_fall_back_too(monkeypatch):
+    """A DFA within its state budget whose doubling tables would exceed windows.MAX_CELLS (many
+    candidates, long traces) is simulated as well, with the same answers."""
+    query = load_scenario("examples/queries/s1_lane_change_stationary_car.scenic")
+    traces = [t for t in readers.read_traces("examples/sample") if t.name.startswith("s1_")]
+    expected = [_answers(query, trace, trace.n_frames // 2) for trace in traces]
+    simulated = []
+
+    def counted(*args):
+        simulated.append(args)
+        return simulate_reach(*args)
+
+    monkeypatch.setattr("scenegrep.scenario.windows.MAX_CELLS", 1)
+    monkeypatch.setattr("scenegrep.scenario.search.simulate_reach", counted)
+    fresh = load_scenario("examples/queries/s1_lane_change_stationary_car.scenic")
+    assert [_answers(fresh, trace, trace.n_frames // 2) for trace in traces] == expected
+    assert any(expected) and simulated and not any(a.over_budget for a in fresh._automata.values())

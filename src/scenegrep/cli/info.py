@@ -1,10 +1,17 @@
-"""``scenegrep info PATH...``: what an input holds (format, frames, duration, objects per class, map)."""
+"""``scenegrep info PATH...``: what an input holds (format, frames, duration, objects per class, map).
+
+A folder of trace files is summarised file by file, as the query commands find them; over a
+folder or several paths an unreadable input is one ``scenegrep: failed:`` line on stderr and the
+others are summarised (exit code 3). One bad file given alone is a user error (exit code 2).
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
 from typing import Any
+
+from .inputs import each_input
 
 
 def add_parser(subparsers: Any) -> None:
@@ -50,16 +57,21 @@ def _map_lines(m: dict[str, Any]) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Print each input's summary; over a folder or several paths an unreadable input is a
+    failed line on stderr and the others are summarised (exit code 3), see :mod:`.inputs`."""
+    return each_input(args.paths, lambda path: _print_summary(path, args))
+
+
+def _print_summary(path: str, args: argparse.Namespace) -> None:
+    """Print the summary of one input: a JSON document with ``--json``, else text lines."""
     from ..summary import describe
 
-    for path in args.paths:
-        summary = describe(path, with_map=not args.no_map)
-        if args.json:
-            print(json.dumps(summary))
-            continue
-        print(f"{path}: {summary['description']} [{summary['format']}]")
-        for trace in summary["traces"]:
-            print("\n".join(_trace_lines(trace)))
-        for road_map in summary.get("maps", []):
-            print("\n".join(_map_lines(road_map)))
-    return 0
+    summary = describe(path, with_map=not args.no_map)
+    if args.json:
+        print(json.dumps(summary))
+        return
+    print(f"{path}: {summary['description']} [{summary['format']}]")
+    for trace in summary["traces"]:
+        print("\n".join(_trace_lines(trace)))
+    for road_map in summary.get("maps", []):
+        print("\n".join(_map_lines(road_map)))

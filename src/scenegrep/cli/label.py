@@ -3,7 +3,10 @@
 Writes every input trace, with derived behaviour label sets (and confidences) and the lanes
 found on the map, as ``OUT/<trace name>.parquet``; prints per-class label statistics on stdout
 (``--json`` for a JSON document). The thresholds are those of ``--config`` (default: the
-shipped, documented ``thresholds.toml``).
+shipped, documented ``thresholds.toml``). A folder of traces is searched as the query commands
+search it; over a folder or several paths an input that cannot be read or labelled is one
+``scenegrep: failed:`` line on stderr and the others are written (exit code 3). One bad file
+given alone is a user error (exit code 2).
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from .inputs import each_input
 from .layers import add_unknown_layers_argument, report_unknown_layers, unknown_layers_of
 
 
@@ -58,7 +62,9 @@ def run(args: argparse.Namespace) -> int:
     choice = unknown_layers_of(args)
     names: set[str] = set()
     with tqdm(desc="labelling", unit=" traces", disable=args.quiet, file=sys.stderr, delay=0.5) as progress:
-        for path in args.data:
+
+        def label_input(path: str) -> None:
+            """Label and write every trace of one input."""
             for trace in readers.read_traces(path):
                 road_map = fixed_map or (readers.read_map(trace.map_source) if trace.map_source else None)
                 try:
@@ -68,10 +74,12 @@ def run(args: argparse.Namespace) -> int:
                 write_trace_parquet(labelled, output / f"{_unique(trace.name, names)}.parquet")
                 statistics.add(labelled)
                 progress.update()
+
+        code = each_input(args.data, label_input)
     text = json.dumps(statistics.as_dict(), indent=1) if args.json else statistics.table()
     sys.stdout.write(text + "\n")
     report_unknown_layers(choice)
-    return 0
+    return code
 
 
 def _unique(name: str, taken: set[str]) -> str:

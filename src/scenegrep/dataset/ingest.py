@@ -109,7 +109,7 @@ def _collect(path: Path, explicit: bool, sources: list[Source], errors: list[tup
     """Add the sources at ``path`` (a given path when ``explicit``, else one found in a directory)."""
     try:
         if path.is_dir():
-            found = _directory_format(path)
+            found = directory_format(path)
             if found is not None:
                 sources.append(Source(str(path.resolve()), found))
                 return
@@ -135,7 +135,7 @@ def _file_format(path: Path, explicit: bool) -> str | None:
     return name if name is not None and name not in SKIPPED and readers.FORMATS[name].traces else None
 
 
-def _directory_format(path: Path) -> str | None:
+def directory_format(path: Path) -> str | None:
     """The format of a directory that is one input (an Argoverse 2 log or scenario), else None."""
     try:
         name = readers.detect_format(path)

@@ -179,11 +179,14 @@ def sandbox(tmp_path_factory) -> Iterator[Callable[[list[str]], dict]]:
 
 
 def check_outcome(outcome: dict, name: str) -> None:
-    """A result (exit 0) or one line naming the input (exit 2); nothing else."""
+    """A result (exit 0) or one line naming the input (exit 2); over a folder (``name`` empty) also
+    one line naming the bad file while the others are summarised (exit 3); nothing else."""
     text = outcome["stderr"]
     assert outcome["signal"] is None, f"killed by signal {outcome['signal']} after {outcome['seconds']:.1f} s"
     assert "Traceback" not in text, text
-    assert outcome["exit"] in (0, 2), (outcome["exit"], text)
+    assert outcome["exit"] in ((0, 2) if name else (0, 2, 3)), (outcome["exit"], text)
+    if outcome["exit"] == 3:
+        assert text.count("\n") == 1 and text.startswith("scenegrep: failed: "), text
     if outcome["exit"] == 2:
         assert text.count("\n") == 1 and text.startswith("scenegrep: error: "), text
         assert name in text, text

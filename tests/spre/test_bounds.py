@@ -13,15 +13,23 @@ shape, without recursion errors.
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.cli.main import main
+from scenegrep.errors import UserError
+from scenegrep.spre import compile_query, search
+from scenegrep.spre.evaluate import MAX_ROWS_PER_FRAME
 from scenegrep.spre.automaton import MAX_EDGES, compile_automaton
 from scenegrep.spre.parser import parse
+from tests.spre.test_semantics import frames_matching, image_trace
 from scenegrep.spre.tokens import MAX_CHARACTERS, MAX_NESTING, MAX_NODES, MAX_POSITIONS
 
 TRACE = "examples/sample/fig1_lane_change-000.parquet"
@@ -120,3 +128,56 @@ def test_a_bounded_repeat_compiles_as_its_nested_spelling(item, low, extra):
     counted = compile_automaton(parse(f"{item}{{{low},{low + extra}}}"))
     spelled = compile_automaton(parse("".join([item] * low) + _nested(item, extra)))
     assert counted == spelled
+
+
+NUSCENES = "/work/shared/real_data/nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl"
+NESTED = "[" + "E(x := [:car:]) " * 94 + "x]"
+PEAK_RSS = """
+import resource, sys
+from scenegrep.cli.main import main
+code = main(["spre", "--space", "topdown", sys.argv[1], sys.argv[2]])
+print(code, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)
+"""
+
+
+@pytest.mark.skipif(not Path(NUSCENES).exists(), reason="needs ../shared/real_data")
+def test_nested_quantifiers_over_a_real_trace_are_a_bounded_one_line_error():
+    """94 nested quantifiers over every car of a nuScenes scene: before any work, the
+    quantifier whose object combinations pass the per-frame limit is named with the frame; a
+    per-trace error, so a failed row (exit 3), in seconds and under 500 MB peak RSS."""
+    began = time.perf_counter()
+    run = subprocess.run(
+        [sys.executable, "-c", PEAK_RSS, NESTED, NUSCENES],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": "src"},
+        timeout=60,
+    )
+    elapsed = time.perf_counter() - began
+    code, rss_mb = map(int, run.stdout.split())
+    failed = [line for line in run.stderr.splitlines() if line.startswith("scenegrep: failed:")]
+    assert code == 3 and len(failed) == 1, run.stderr[:500]
+    column = 1 + 4 * len("E(x := [:car:]) ") + 1
+    assert f"<query>:1:{column}: nested quantifiers make more than {MAX_ROWS_PER_FRAME}" in failed[0]
+    assert "(frame " in failed[0] and "Traceback" not in run.stderr
+    assert rss_mb < 500 and elapsed < 20, (rss_mb, elapsed)
+
+
+def test_nested_quantifiers_over_a_long_trace_answer():
+    """Three nested quantifiers over a 100,000-frame trace with two cars per frame (every frame
+    within the per-frame limit) answer: each frame matches."""
+    cars = [[("car", 10, 10, 4, 4), ("car", 50, 50, 4, 4)]]
+    trace = image_trace([cars] * 100_000 + [[[]]])
+    query = "[E(x := [:car:]) (E(y := [:car:]) (E(z := [:car:]) (z & @dist(x, y) > 1)))]"
+    assert frames_matching(query, trace) == list(range(100_000))
+
+
+def test_the_per_frame_limit_is_exact():
+    """A frame just within the limit (316 squared rows) answers; 317 squared is refused at the inner quantifier."""
+    side = round(MAX_ROWS_PER_FRAME ** (1 / 2))
+    query = compile_query("[E(x := [:car:]) (E(y := [:car:]) (x & y))]")
+    trace = image_trace([[[("car", 10, 10, 4, 4)] * side]])
+    assert [m.start for m in search(query, trace, online=True)] == [0]
+    more = image_trace([[[("car", 10, 10, 4, 4)] * (side + 1)]])
+    with pytest.raises(UserError, match=r"<query>:1:19: .* object combinations in one frame \(frame 0\)"):
+        list(search(query, more, online=True))

@@ -2,12 +2,14 @@
 queries and random streams, offline and online, in both syntaxes' semantics."""
 
 import json
+from unittest.mock import patch
 
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from scenegrep.readers.strem_json import decode
 from scenegrep.spre import SearchOptions, compile_query, search
+from scenegrep.spre import evaluate
 from scenegrep.spre.search import CompiledQuery
 from tests.spre import reference as ref
 
@@ -155,3 +157,17 @@ def test_formulas_match_reference(formula, frames, strem):
     found = {m.start for m in search(query, trace, SearchOptions(), online=True)}
     expected = {i for i, f in enumerate(frames) if ref.holds(formula, f, {}, strem)}
     assert found == expected, query.text
+
+
+@settings(max_examples=150)
+@given(formulas, st.lists(st.lists(boxes, max_size=4), min_size=1, max_size=6), st.integers(1, 40))
+def test_chunked_evaluation_equals_whole(formula, frames, cells):
+    """Evaluating a quantified formula in chunks of a few samples (a tiny chunk budget) finds
+    exactly the frames that one whole evaluation finds."""
+    assume(_variables(formula[2]) <= {v for v, _ in formula[1]})
+    query = compile_query(f"[{ref.formula_text(formula)}]")
+    trace = decode(boxes_document(frames), "<test>", "t")
+    whole = [m.start for m in search(query, trace, SearchOptions(), online=True)]
+    with patch.object(evaluate, "CHUNK_CELLS", cells):
+        chunked = [m.start for m in search(query, trace, SearchOptions(), online=True)]
+    assert chunked == whole, query.text

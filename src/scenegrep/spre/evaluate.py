@@ -8,6 +8,15 @@ of a formula is evaluated once, vectorised over all rows: terms give :class:`Reg
 metric expressions give :class:`Values` (a list of numbers per row), formulas give one
 boolean per row. Comparisons are existential over value pairs (an empty side is false),
 relations over region pairs; arithmetic takes the cartesian product of its operands.
+
+Nested quantifiers multiply the rows of a sample by the object count at each level, so before
+evaluating, :meth:`Evaluator.frames` computes per sample, vectorised, the rows each quantifier
+makes (the product of its classes' object counts over the enclosing levels) and refuses a frame
+whose rows at some quantifier exceed :data:`MAX_ROWS_PER_FRAME` (:class:`TooManyRows`, naming
+the quantifier and the frame). Within that limit it evaluates chunks of whole samples whose
+estimated peak held cells (rows times bound variables, summed over the nested levels) stay
+under :data:`CHUNK_CELLS`, so memory is bounded per chunk, whatever the trace's length; each
+row's truth depends only on its sample, so chunked and whole evaluation agree.
 """
 
 from __future__ import annotations
@@ -23,6 +32,21 @@ from . import syntax as s
 from .space import Space
 
 shapely = lazy_import("shapely")
+
+MAX_ROWS_PER_FRAME = 100_000
+"""Most evaluation rows (object combinations of nested quantifiers) in one frame."""
+CHUNK_CELLS = 20_000_000
+"""Peak held row cells (8 bytes each) one chunk of samples may need, about 160 MB."""
+
+
+class TooManyRows(Exception):
+    """A quantifier makes more than :data:`MAX_ROWS_PER_FRAME` rows in ``frame`` (a position
+    in the space's frames)."""
+
+    def __init__(self, quantifier: s.Quantifier, frame: int):
+        super().__init__(f"nested quantifiers make more than {MAX_ROWS_PER_FRAME} object combinations in one frame")
+        self.quantifier = quantifier
+        self.frame = frame
 
 
 @dataclass(frozen=True)
@@ -73,11 +97,51 @@ class Evaluator:
         return Context(np.arange(self.space.n_samples), fixed)
 
     def frames(self, formula: s.Formula, bindings: dict[str, int] | None = None) -> np.ndarray:
-        """Truth of a formula in every frame: some sample of the frame satisfies it."""
-        truth = self.formula(formula, self.base(bindings))
+        """Truth of a formula in every frame: some sample of the frame satisfies it. Raises
+        :class:`TooManyRows` before any work when a frame is over :data:`MAX_ROWS_PER_FRAME`;
+        evaluates in chunks of samples of at most about :data:`CHUNK_CELLS` cells."""
+        ctx = self.base(bindings)
         out = np.zeros(self.space.n_frames, bool)
-        out[self.space.sample_frame[truth]] = True
+        for rows in self._chunks(self._cells(formula, np.ones(self.space.n_samples), 1)):
+            part = ctx.take(rows)
+            out[self.space.sample_frame[part.sample[self.formula(formula, part)]]] = True
         return out
+
+    def _cells(self, f: s.Formula, rows: np.ndarray, width: int) -> np.ndarray:
+        """Per sample, the peak cells held evaluating ``f`` on ``rows`` rows per sample (float)
+        of ``width`` cells each; raises :class:`TooManyRows` where a quantifier's rows per frame
+        exceed the limit."""
+        match f:
+            case s.Not(operand):
+                return self._cells(operand, rows, width)
+            case s.And(left, right) | s.Or(left, right):
+                return np.maximum(self._cells(left, rows, width), self._cells(right, rows, width))
+            case s.Quantifier(_, bindings, body):
+                inner = rows * np.prod([self._object_counts(b.atom) for b in bindings], axis=0)
+                self._check_rows(f, inner)
+                wider = width + len(bindings)
+                return rows * width + inner * wider + self._cells(body, inner, wider)
+        return rows * width
+
+    def _object_counts(self, atom: s.ClassAtom) -> np.ndarray:
+        """Per sample, how many objects of the class it has."""
+        return np.bincount(self.class_rows(atom)[1], minlength=self.space.n_samples).astype(float)
+
+    def _check_rows(self, q: s.Quantifier, rows: np.ndarray) -> None:
+        """Raise :class:`TooManyRows` at the first frame whose samples hold more than
+        :data:`MAX_ROWS_PER_FRAME` rows."""
+        per_frame = np.bincount(self.space.sample_frame, weights=rows, minlength=self.space.n_frames)
+        over = np.flatnonzero(~(per_frame <= MAX_ROWS_PER_FRAME))
+        if len(over):
+            raise TooManyRows(q, int(over[0]))
+
+    @staticmethod
+    def _chunks(cells: np.ndarray) -> list[np.ndarray]:
+        """Consecutive sample ranges whose cells sum to at most :data:`CHUNK_CELLS` (a sample
+        over it alone is its own chunk)."""
+        chunk = np.floor(np.cumsum(cells) / CHUNK_CELLS).astype(np.int64)
+        cuts = np.flatnonzero(np.diff(chunk)) + 1
+        return np.split(np.arange(len(cells)), cuts)
 
     # ------------------------------------------------------------------ formulas
     def formula(self, f: s.Formula, ctx: Context) -> np.ndarray:

@@ -31,7 +31,7 @@ from .automaton import (
 )
 from .checks import check, check_strem_online
 from .errors import query_error
-from .evaluate import Evaluator
+from .evaluate import Evaluator, TooManyRows
 from .parser import parse
 from .space import Space, image_space, topdown_space
 from .strem_parser import parse_strem
@@ -127,12 +127,18 @@ def _candidates(query: CompiledQuery, evaluator: Evaluator) -> dict[s.Binding, l
     return out
 
 
-def letter_masks(automaton: Automaton, evaluator: Evaluator) -> list[int]:
-    """Per frame, the bit mask of the automaton's letters that hold in it."""
+def letter_masks(automaton: Automaton, evaluator: Evaluator, query: CompiledQuery, trace: LabelTrace) -> list[int]:
+    """Per frame, the bit mask of the automaton's letters that hold in it; a :class:`UserError`
+    at the quantifier, naming the dataset frame index, when nested quantifiers make too many
+    rows in a frame of ``trace`` (the evaluator's trace)."""
     n = evaluator.space.n_frames
     truth = np.zeros((len(automaton.letters), n), dtype=bool)
     for k, (formula, bindings) in enumerate(automaton.letters):
-        truth[k] = evaluator.frames(formula, dict(bindings))
+        try:
+            truth[k] = evaluator.frames(formula, dict(bindings))
+        except TooManyRows as exc:
+            frame = int(trace.frame_index[exc.frame])
+            raise query_error(f"{exc} (frame {frame})", query.text, *exc.quantifier.span) from None
     if len(automaton.letters) <= 62:
         weights = np.left_shift(np.int64(1), np.arange(len(automaton.letters), dtype=np.int64))
         return (truth.T.astype(np.int64) * weights).sum(axis=1).tolist()
@@ -151,7 +157,7 @@ class TraceSearch:
         self.evaluator = Evaluator(build_space(trace, options, query.compat), strem=query.compat)
         self.candidates = _candidates(query, self.evaluator)
         self.automaton = automaton_of(query, self.candidates)
-        self.masks = letter_masks(self.automaton, self.evaluator)
+        self.masks = letter_masks(self.automaton, self.evaluator, query, trace)
 
     def matches(self, spans: Iterable[tuple[int, int]]) -> Iterator[Match]:
         """Matches of the given (start, end) position pairs."""
@@ -167,7 +173,7 @@ class TraceSearch:
             for obj in objects:
                 only = {**self.candidates, binding: [obj]}
                 automaton = automaton_of(self.query, only)
-                masks = letter_masks(automaton, self.evaluator)[start:end]
+                masks = letter_masks(automaton, self.evaluator, self.query, self.trace)[start:end]
                 ends = longest_from_each_start(automaton, masks)
                 if len(ends) and ends[0] == end - start:
                     bound[binding.var] = str(self.evaluator.space.object_ids[obj])
@@ -218,7 +224,7 @@ def search_stream(
         frames = list(
             zip(range(position, position + chunk.n_frames), chunk.frame_index.tolist(), chunk.frame_time.tolist())
         )
-        for (first, first_index, first_time), k in scan.feed(letter_masks(automaton, evaluator), frames):
+        for (first, first_index, first_time), k in scan.feed(letter_masks(automaton, evaluator, query, chunk), frames):
             _, last_index, last_time = frames[k]
             yield Match(first, position + k + 1, first_index, last_index, first_time, last_time)
         position += chunk.n_frames

@@ -1,7 +1,8 @@
 """Everything a SpRE can make huge is bounded before work starts (README "Limits"): nesting, the
 number of terms, the text's length, repetition counts and the automaton's size are each a one-line
-error at line:column with exit code 2, fast; queries within the limits answer, whatever their
-shape, without recursion errors.
+error at line:column with exit code 2 (a failed row, exit 3, when the limit depends on the trace:
+the automaton built per trace, nested quantifiers' object combinations per frame), fast; queries
+within the limits answer, whatever their shape, without recursion errors.
 
 * explicit huge queries through the command line (``main([...])`` in process): exit 2, the error
   line names the place and the limit, only the caret display follows (clipped to a short line), no
@@ -55,9 +56,14 @@ HUGE = {
     "a huge count": ("[[:car:]]{0,100000000000}", f"above the limit of {MAX_POSITIONS}"),
     "a 5,000-digit count": ("[[:car:]]{" + "9" * 5_000 + "}", f"above the limit of {MAX_POSITIONS}"),
     "repeats of repeats": ("(([[:car:]]{200}){200})", f"more than {MAX_POSITIONS} frame letters"),
+}
+
+PER_TRACE = {
     "track binders over every car": ("E(x := [:car:])" * 15 + "[x]", f"more than {MAX_POSITIONS} frame letters"),
     "a quadratic automaton": ("([[:car:]]?){0,5000}", f"more than {MAX_EDGES} transitions"),
 }
+"""Limits of the automaton built per trace (track binders range over its objects): over files, a
+failed row with the query's place (exit 3, the one execution path of dataset/files.py)."""
 
 STREM = {
     "groups": ("(" * DEEP + "[[:car:]]" + ")" * DEEP, NESTS),
@@ -86,6 +92,14 @@ def _assert_one_line_error(code: int, lines: list[str], elapsed: float, message:
 def test_a_huge_query_is_a_one_line_error(name, capsys):
     query, message = HUGE[name]
     _assert_one_line_error(*_run(["spre", "--space", "topdown", query, TRACE], capsys), message)
+
+
+@pytest.mark.parametrize("name", PER_TRACE)
+def test_a_per_trace_limit_is_a_failed_row(name, capsys):
+    query, message = PER_TRACE[name]
+    code, lines, elapsed = _run(["spre", "--space", "topdown", query, TRACE], capsys)
+    assert code == 3 and lines[0].startswith("scenegrep: failed: ") and message in lines[0], lines[:1]
+    assert "<query>:1:1: " in lines[0] and len(lines) == 2 and elapsed < 5
 
 
 @pytest.mark.parametrize("name", STREM)

@@ -18,6 +18,7 @@ import pytest
 
 from scenegrep.cli.main import main
 from scenegrep.errors import UserError
+from scenegrep.model.layers import UnknownLayers
 from scenegrep.model import BehaviourLabels
 from scenegrep.readers.av2_forecasting import read_trace
 from scenegrep.readers.av2_sensor import read_trace as read_sensor_log
@@ -31,6 +32,7 @@ MOVING = ("Car", 1.75, 20.0, 0.0, 4.5, 2.0, 0.0, 10.0)  # northbound at 10 m/s
 DRIFTING = ("Car", 1.75, 20.0, 0.0, 4.5, 2.0, 6.0, 8.0)  # 10 m/s, but not along the heading
 STOPPED = ("Car", 1.75, 20.0, 0.0, 4.5, 2.0, 0.0, 0.0)
 UNKNOWN = ("Car", 1.75, 20.0, 0.0)  # no velocity in the data
+PERMISSIVE = UnknownLayers("permissive")  # the synthetic map publishes no shoulders
 
 
 @pytest.mark.parametrize(
@@ -59,10 +61,11 @@ def test_the_speed_tolerance_admits_speeds_within_it():
 
 def test_a_nearest_miss_names_the_speed_tolerance_that_admits_it():
     query = compile_scene(HEADER + "ego = new Car at (1.75, 20), facing 0 deg, with speed 12.5\n")
-    result = query.match(trace_of({"ego": MOVING}), MAP, SceneOptions())
+    result = query.match(trace_of({"ego": MOVING}), MAP, SceneOptions(unknown_layers=PERMISSIVE))
     miss = nearest_miss(result, np.array([0]))
     assert [(s.name, s.value) for s in miss.needed] == [("speed", pytest.approx(2.5, rel=1e-3))]
-    assert query.match(trace_of({"ego": MOVING}), MAP, SceneOptions(miss.tolerance(Tolerance()))).matched[0]
+    admitted = SceneOptions(miss.tolerance(Tolerance()), unknown_layers=PERMISSIVE)
+    assert query.match(trace_of({"ego": MOVING}), MAP, admitted).matched[0]
 
 
 @pytest.mark.parametrize(

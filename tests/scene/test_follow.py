@@ -185,7 +185,7 @@ def test_a_label_off_the_walk_or_facing_away_does_not_match():
 def test_the_follow_operator_is_decided_the_same_way():
     program = "ego = new Car on road\np = follow roadDirection from ego for Range(10, 30)\nc = new Car at p"
     query = compile_scene(HEADER + program, "follow.scenic")
-    options = SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"})
+    options = SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"}, unknown_layers=ANYWHERE)
     ex, ey = reference_follow(1.75, 2.0, 25.0)
     on, off = (
         query.match(trace_of({"ego": ("Car", 1.75, 2.0, 0.0), "c": ("Car", x, ey, end_heading(ex, ey))}), MAP, options)
@@ -200,7 +200,7 @@ def test_a_distance_bounded_by_another_random_variable():
     """``Range(d, 20)`` with ``d`` random: D's range comes from d's, and the pieces are exact."""
     program = "ego = new Car on road\nd = Range(8, 12)\nc = new Car following roadDirection from ego for Range(d, 20)"
     query = compile_scene(HEADER + program, "follow.scenic")
-    options = SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"})
+    options = SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"}, unknown_layers=ANYWHERE)
     for distance, expected in ((9.0, True), (15.0, True), (7.0, False), (21.0, False)):
         ex, ey = reference_follow(1.75, 2.0, distance)
         trace = trace_of({"ego": ("Car", 1.75, 2.0, 0.0), "c": ("Car", ex, ey, end_heading(ex, ey))})
@@ -219,7 +219,7 @@ def test_a_walk_that_may_exceed_two_kilometres_is_a_user_error(distance):
     query = compile_scene(HEADER + program, "follow.scenic")
     trace = trace_of({"ego": ("Car", 1.75, 2.0, 0.0), "c": ("Car", 1.75, 30.0, 0.0)})
     with pytest.raises(UserError, match="exceed 2000 m"):
-        query.match(trace, MAP, SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"}))
+        query.match(trace, MAP, SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"}, unknown_layers=ANYWHERE))
 
 
 def test_a_requirement_on_the_followed_car_is_decided_on_each_piece():
@@ -228,7 +228,7 @@ def test_a_requirement_on_the_followed_car_is_decided_on_each_piece():
         "ego = new Car on road\nd = Range(10, 30)\nc = new Car following roadDirection from ego for d\nrequire d > 20"
     )
     query = compile_scene(HEADER + program, "follow.scenic")
-    options = SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"})
+    options = SceneOptions(Tolerance(1e-6, 1e-6), correspondence={"c": "c"}, unknown_layers=ANYWHERE)
     answers = []
     for d in (15.0, 25.0):
         ex, ey = reference_follow(1.75, 2.0, d)

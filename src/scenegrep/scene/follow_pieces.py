@@ -38,7 +38,8 @@ to change inside a piece.
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from typing import Self
 
 import numpy as np
 import shapely
@@ -82,8 +83,16 @@ class Linework:
     polylines: Polylines
 
 
+class _Columns:
+    """Equal-length numpy columns (the dataclass's fields) whose rows are taken together."""
+
+    def take(self, index: np.ndarray) -> Self:
+        """The rows at ``index``, as a new instance of the same class."""
+        return type(self)(*(getattr(self, f.name)[index] for f in fields(self)))
+
+
 @dataclass
-class Pieces:
+class Pieces(_Columns):
     """D intervals with one heading sequence: for start ``row``, every D in [lo, hi] ends the walk
     at ``start + D * (ax, ay)`` with the field taking ``heading`` there (a row per possible value)."""
 
@@ -93,10 +102,6 @@ class Pieces:
     ax: np.ndarray
     ay: np.ndarray
     heading: np.ndarray
-
-    def take(self, index: np.ndarray) -> Pieces:
-        """The pieces at ``index``."""
-        return Pieces(*(getattr(self, k)[index] for k in ("row", "lo", "hi", "ax", "ay", "heading")))
 
 
 def linework(geometry: MapGeometry) -> Linework:
@@ -277,7 +282,7 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 @dataclass
-class _Branches:
+class _Branches(_Columns):
     """Walks under enumeration: start row, D interval, step count, and the end so far (X + D a)."""
 
     row: np.ndarray
@@ -286,9 +291,6 @@ class _Branches:
     steps: np.ndarray
     ax: np.ndarray
     ay: np.ndarray
-
-    def take(self, index: np.ndarray) -> _Branches:
-        return _Branches(*(getattr(self, k)[index] for k in ("row", "lo", "hi", "steps", "ax", "ay")))
 
 
 def follow_pieces(

@@ -21,6 +21,7 @@ in one transaction, after its Parquet file is complete.
 
 from __future__ import annotations
 
+import time
 from datetime import datetime
 from pathlib import Path
 from typing import Any
@@ -61,6 +62,22 @@ ALTER TABLE results ADD COLUMN IF NOT EXISTS values VARCHAR;
 """
 
 PER_TRACE_TABLES = ("objects", "frame_counts", "labels")
+LOCK_WAIT = 10.0
+"""Seconds to wait for another process's writing connection to close (runs and ingest hold one
+only briefly: for their plan and their commits) before the catalog is a user error."""
+
+
+def _connect(path: Path | None, read_only: bool) -> duckdb.DuckDBPyConnection:
+    """A DuckDB connection to ``path`` (None: in memory), waiting up to :data:`LOCK_WAIT` seconds
+    while another process holds the file's lock."""
+    deadline = time.monotonic() + LOCK_WAIT
+    while True:
+        try:
+            return duckdb.connect(":memory:" if path is None else str(path), read_only=read_only)
+        except duckdb.IOException as exc:
+            if "Could not set lock" not in str(exc) or time.monotonic() > deadline:
+                raise UserError(f"cannot open the catalog: {str(exc).splitlines()[0]}", at(path)) from None
+            time.sleep(0.05)
 
 
 def _with_trace_id(table: pa.Table, trace_id: str) -> pa.Table:
@@ -82,10 +99,7 @@ class Catalog:
             raise UserError("not a scenegrep dataset (no catalog.duckdb; create one with scenegrep ingest)", at(root))
         if path is not None and create:
             path.parent.mkdir(parents=True, exist_ok=True)
-        try:
-            self.db = duckdb.connect(":memory:" if path is None else str(path), read_only=read_only)
-        except duckdb.IOException as exc:
-            raise UserError(f"cannot open the catalog: {str(exc).splitlines()[0]}", at(path)) from None
+        self.db = _connect(path, read_only)
         if path is not None and not read_only:
             self.db.execute(SCHEMA)
             self.db.execute("INSERT OR REPLACE INTO meta VALUES ('schema_version', ?)", [SCHEMA_VERSION])

@@ -56,11 +56,13 @@ HUGE = {
     "a huge count": ("[[:car:]]{0,100000000000}", f"above the limit of {MAX_POSITIONS}"),
     "a 5,000-digit count": ("[[:car:]]{" + "9" * 5_000 + "}", f"above the limit of {MAX_POSITIONS}"),
     "repeats of repeats": ("(([[:car:]]{200}){200})", f"more than {MAX_POSITIONS} frame letters"),
+    "a quadratic automaton": ("([[:car:]]?){0,5000}", f"more than {MAX_EDGES} transitions"),
 }
+"""Queries over a limit before any trace is read (a query without track binders has its
+automaton built at compile time): one error line, exit 2."""
 
 PER_TRACE = {
     "track binders over every car": ("E(x := [:car:])" * 15 + "[x]", f"more than {MAX_POSITIONS} frame letters"),
-    "a quadratic automaton": ("([[:car:]]?){0,5000}", f"more than {MAX_EDGES} transitions"),
 }
 """Limits of the automaton built per trace (track binders range over its objects): over files, a
 failed row with the query's place (exit 3, the one execution path of dataset/files.py)."""

@@ -13,7 +13,7 @@ frame, the longest non-empty match ending there.
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -40,16 +40,24 @@ from .tokens import MAX_CHARACTERS
 
 @dataclass(frozen=True)
 class CompiledQuery:
-    """A parsed and checked query, with the warnings parsing produced."""
+    """A parsed and checked query, with the warnings parsing produced and, for a query without
+    track binders, its automaton (which then depends on no trace, so it is built, and its size
+    checked, once before any trace is read)."""
 
     text: str
     tree: s.Query
     compat: bool = False
     warnings: tuple[str, ...] = ()
+    automaton: Automaton | None = None
 
     @property
     def has_track_binders(self) -> bool:
         return any(isinstance(node, s.TrackBinder) for node in self.tree.walk())
+
+    def automaton_over(self, candidates: dict[s.Binding, list[int]]) -> Automaton:
+        """The automaton with track binders over ``candidates`` (the one built at compile time
+        when there are none)."""
+        return self.automaton if self.automaton is not None and not candidates else automaton_of(self, candidates)
 
 
 def compile_query(text: str, compat: bool = False, source: str = "<query>") -> CompiledQuery:
@@ -63,7 +71,8 @@ def compile_query(text: str, compat: bool = False, source: str = "<query>") -> C
     else:
         tree, warnings = parse(text, source), []
     checked = check(tree, text, source, compat)
-    return CompiledQuery(text, tree, compat, tuple(warnings) + checked.warnings)
+    query = CompiledQuery(text, tree, compat, tuple(warnings) + checked.warnings)
+    return query if query.has_track_binders else replace(query, automaton=automaton_of(query))
 
 
 def automaton_of(query: CompiledQuery, candidates: dict[s.Binding, list[int]] | None = None) -> Automaton:
@@ -156,7 +165,7 @@ class TraceSearch:
         self.trace = trace
         self.evaluator = Evaluator(build_space(trace, options, query.compat), strem=query.compat)
         self.candidates = _candidates(query, self.evaluator)
-        self.automaton = automaton_of(query, self.candidates)
+        self.automaton = query.automaton_over(self.candidates)
         self.masks = letter_masks(self.automaton, self.evaluator, query, trace)
 
     def matches(self, spans: Iterable[tuple[int, int]]) -> Iterator[Match]:
@@ -211,7 +220,7 @@ def search_stream(
         raise UserError("track binders E(...)(...) need the whole trace; they cannot run on a live stream")
     if query.compat:
         check_strem_online(query.tree, query.text)
-    automaton = automaton_of(query)
+    automaton = query.automaton_over({})
     scan = ForwardScan(automaton)
     skip = options.skip
     position = 0

@@ -135,28 +135,26 @@ class ScenarioQuery:
 
         groups = self.scene.groups_for(trace)
 
+        def scene_options(correspondence: dict[str, str], starts: np.ndarray) -> SceneOptions:
+            return SceneOptions(
+                options.tolerance,
+                visible_distance=options.visible_distance,
+                correspondence=correspondence,
+                frames=starts,
+            )
+
         def scene_starts(assignment: Assignment, starts: np.ndarray, newest: str) -> np.ndarray:
             decided = completed_groups(groups, set(assignment), newest)
             if not decided:
                 return starts
             correspondence = {name: str(ids[row]) for name, row in assignment.items()}
-            scene_options = SceneOptions(
-                options.tolerance,
-                visible_distance=options.visible_distance,
-                correspondence=correspondence,
-                frames=starts,
-            )
-            return starts[self.scene.frames_matching(trace, geometry, scene_options, decided)[starts]]
+            matching = self.scene.frames_matching(trace, geometry, scene_options(correspondence, starts), decided)
+            return starts[matching[starts]]
 
         def scene_at(correspondence: dict[str, str], starts: np.ndarray) -> SceneResult:
-            scene_options = SceneOptions(
-                options.tolerance,
-                visible_distance=options.visible_distance,
-                correspondence=correspondence,
-                frames=starts,
-            )
-            matches = match_trace(self.scene.program, groups, trace, geometry, scene_options)
-            return SceneResult(trace, self.scene, matches, labels_of(trace), geometry, scene_options)
+            scene_options_at = scene_options(correspondence, starts)
+            matches = match_trace(self.scene.program, groups, trace, geometry, scene_options_at)
+            return SceneResult(trace, self.scene, matches, labels_of(trace), geometry, scene_options_at)
 
         kinds = {name: objects[name].kinds for name in self.hfsms}
         search = Search(self.hfsms, kinds, self.guards, automata, obs, m, scene_starts, options.find_all)

@@ -33,8 +33,6 @@ def unknown_layers_of(args: argparse.Namespace) -> Any:
 def report_unknown_layers(choice: Any, counted: bool = True) -> None:
     """Print the choice and the decisions it affected on stderr (nothing without a choice); when
     the decisions were made in worker processes (not ``counted`` here), say so instead of a count."""
-    line = choice.report()
-    if line is not None and not counted:
-        line = line.rsplit("; decisions affected:", 1)[0] + "; decisions made in worker processes are not counted"
+    line = choice.report(counted)
     if line is not None:
         print(f"scenegrep: {line}", file=sys.stderr)

@@ -207,3 +207,18 @@ def test_streamed_documents_are_checked_like_files():
     }
     with pytest.raises(UserError, match=r"^<stdin>:1: not a valid scenegrep-json input: frame 1 \(index 1\)"):
         decode(json.dumps(document).encode(), "<stdin>:1", "stdin")
+
+
+def test_a_parquet_footer_with_a_column_name_not_in_utf8_is_one_line_when_sniffed(tmp_path, capsys):
+    """Found by the fuzz suite: detecting the format reads the Parquet schema, whose names
+    Arrow decodes as UTF-8 (a UnicodeDecodeError escaped as a traceback from `info`)."""
+    from scenegrep.cli.main import main
+
+    data = bytearray((REPO / "examples" / "sample" / "s3_pass_pedestrian-000.parquet").read_bytes())
+    footer = len(data) - 8 - int.from_bytes(data[-8:-4], "little")  # the footer's length precedes 'PAR1'
+    data[data.index(b"heading", footer)] = 0xC4  # the first name in the footer is the schema's column name
+    bad = tmp_path / "bad.parquet"
+    bad.write_bytes(bytes(data))
+    assert main(["info", "--no-map", str(bad)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(f"scenegrep: error: {bad}: ") and "Traceback" not in err[0]

@@ -126,7 +126,9 @@ def detect_format(path: str | Path) -> str:
         if module("trace-folder").trace_files(path):
             return "trace-folder"
         raise UserError("a directory that is neither an Argoverse 2 log or scenario nor holds trace files", at(path))
-    found = sniff_file(regular_file(path, "a trace or map file, or a recording directory"))
+    file = regular_file(path, "a trace or map file, or a recording directory")
+    with malformed(file, file.suffix.lstrip(".").lower() or "input"):  # sniffing reads headers too
+        found = sniff_file(file)
     if found is None:
         raise UserError(f"unrecognised input format; supported: {', '.join(FORMATS)}", at(path))
     return found

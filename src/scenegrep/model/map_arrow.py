@@ -2,7 +2,9 @@
 
 One row per map element; ``kind`` is lane, road, intersection, crosswalk,
 sidewalk, shoulder, curb or drivable. Geometries are WKB (polygons; a curb is a line
-string); lanes also carry their centreline and topology columns. The metadata names the
+string); lanes also carry their centreline and topology columns, sidewalks and crosswalks their
+centreline where the map has one (a file written before they were kept has none: their direction
+is unknown). The metadata names the
 layers the map's format does not publish (``unknown_layers``, layout 2); a layout-1 file, written
 before layers were told apart, has every optional layer it holds no element of unknown.
 """
@@ -69,7 +71,13 @@ def map_to_table(road_map: RoadMap) -> pa.Table:
     rows = [_lane_row(lane) for lane in road_map.lanes]
     for kind, name in zip(_AREA_KINDS, _AREA_FIELDS):
         rows += [
-            {"kind": kind, "id": a.id, "geometry": shapely.to_wkb(a.polygon), "lanes": list(a.lanes)}
+            {
+                "kind": kind,
+                "id": a.id,
+                "geometry": shapely.to_wkb(a.polygon),
+                "lanes": list(a.lanes),
+                "centreline": None if a.centreline is None else shapely.to_wkb(shapely.linestrings(a.centreline)),
+            }
             for a in getattr(road_map, name)
         ]
     rows += [
@@ -110,12 +118,11 @@ def map_from_table(table: pa.Table) -> RoadMap:
     for row, geom in zip(rows, geometry):
         kind = row["kind"]
         if kind == "lane":
-            centre = shapely.get_coordinates(shapely.from_wkb(row["centreline"]))
             lanes.append(
                 Lane(
                     row["id"],
                     geom,
-                    centre,
+                    _coordinates(row["centreline"]),
                     row["road"],
                     bool(row["is_intersection"]),
                     tuple(row["successors"] or ()),
@@ -127,7 +134,8 @@ def map_from_table(table: pa.Table) -> RoadMap:
                 )
             )
         elif kind in areas:
-            areas[kind].append(Area(row["id"], geom, tuple(row["lanes"] or ())))
+            centre = None if row["centreline"] is None else _coordinates(row["centreline"])
+            areas[kind].append(Area(row["id"], geom, tuple(row["lanes"] or ()), centre))
         elif kind == "curb":
             curbs.append(shapely.get_coordinates(geom))
         elif kind == "drivable":
@@ -147,6 +155,11 @@ def map_from_table(table: pa.Table) -> RoadMap:
         shoulder,
         _unknown_layers(meta, held),
     )
+
+
+def _coordinates(wkb: bytes) -> np.ndarray:
+    """The k x 2 vertices of a line string stored as WKB."""
+    return shapely.get_coordinates(shapely.from_wkb(wkb))
 
 
 def _unknown_layers(meta: dict, held: dict[str, Sequence]) -> frozenset[str]:

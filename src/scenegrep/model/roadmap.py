@@ -53,11 +53,17 @@ class Lane:
 
 @dataclass(frozen=True, eq=False)
 class Area:
-    """A polygonal map element (road, intersection, crosswalk, sidewalk) and the lanes it holds."""
+    """A polygonal map element (road, intersection, crosswalk, sidewalk) and the lanes it holds.
+
+    ``centreline`` (k x 2, metres) gives a sidewalk's or crosswalk's direction where the map's
+    format has one (OpenDRIVE through Scenic): Scenic orients the element along the segment of
+    its centreline nearest to a point; None where the format gives none (direction unknown).
+    """
 
     id: str
     polygon: BaseGeometry
     lanes: tuple[str, ...] = ()
+    centreline: np.ndarray | None = None
 
 
 REGION_NAMES = ("lane", "road", "intersection", "crossing", "sidewalk", "drivable")
@@ -99,6 +105,12 @@ class RoadMap:
     def publishes(self, layer: str) -> bool:
         """Whether the map's format publishes ``layer`` (then its elements here are all there are)."""
         return layer not in self.unknown_layers
+
+    def orients(self, layer: str) -> bool:
+        """Whether the map gives the direction of every element of ``layer`` (``sidewalk`` or
+        ``crossing``): the layer is published and each of its elements has a centreline."""
+        areas = {"sidewalk": self.sidewalks, "crossing": self.crosswalks}[layer]
+        return self.publishes(layer) and all(a.centreline is not None for a in areas)
 
     # ------------------------------------------------------------------ lookup tables
     @cached_property
@@ -315,8 +327,8 @@ def _same_element(a: Lane | Area, b: Lane | Area) -> bool:
         mine, theirs = getattr(a, name), getattr(b, name)
         if name == "polygon":
             continue
-        if isinstance(mine, np.ndarray):
-            if not np.array_equal(mine, theirs):
+        if isinstance(mine, np.ndarray) or isinstance(theirs, np.ndarray):
+            if mine is None or theirs is None or not np.array_equal(mine, theirs):
                 return False
         elif mine != theirs:
             return False

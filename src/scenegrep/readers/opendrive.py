@@ -27,7 +27,9 @@ the inverse links. A lane's left/right neighbour is that of its first lane
 section having one, with same direction when both sections run the same way.
 Roads, intersections (holding their maneuvers' connecting lanes), crossings,
 sidewalks, shoulders, the curbs of ordinary roads and the drivable region come over
-as they are in Scenic.
+as they are in Scenic; sidewalks and crossings keep their centrelines (which orient them) and
+Scenic's order. Scenic 3.1.1's OpenDRIVE parser makes no crossings (its ``crossings = ()``), so
+the crossing layer of every OpenDRIVE map is empty.
 """
 
 from __future__ import annotations
@@ -53,7 +55,7 @@ FORMAT = "opendrive"
 UNKNOWN_LAYERS: frozenset[str] = frozenset()
 """Scenic's road network publishes every layer (crossings, sidewalks, curbs, shoulders), so an
 OpenDRIVE map without, say, sidewalks has an empty sidewalk layer, as in Scenic."""
-CONVERSION_VERSION = 4
+CONVERSION_VERSION = 5
 """Bumped whenever the conversion changes, so cached maps are rebuilt."""
 
 
@@ -106,6 +108,14 @@ def _areas(elements: Any) -> tuple[Area, ...]:
     return tuple(Area(e.uid, e.polygons) for e in elements)
 
 
+def _oriented_areas(elements: Any) -> tuple[Area, ...]:
+    """Sidewalks or crossings with their centrelines, in Scenic's order (its union's orientation
+    takes the first element containing a point)."""
+    return tuple(
+        Area(e.uid, e.polygons, centreline=np.asarray(e.centerline.points, np.float64)[:, :2]) for e in elements
+    )
+
+
 def convert_network(network: Any, name: str, source: str) -> RoadMap:
     """A :class:`RoadMap` from a Scenic road network."""
     intersections = tuple(
@@ -118,8 +128,8 @@ def convert_network(network: Any, name: str, source: str) -> RoadMap:
         tuple(_lanes(network)),
         roads,
         intersections,
-        _areas(network.crossings),
-        _areas(network.sidewalks),
+        _oriented_areas(network.crossings),
+        _oriented_areas(network.sidewalks),
         _curbs(network),
         network.drivableRegion.polygons,
         source,

@@ -14,6 +14,7 @@ import tomllib
 from functools import cache
 from pathlib import Path
 
+import numpy as np
 import pytest
 import shapely
 
@@ -40,11 +41,11 @@ TITLES = {
 }
 WALKABLE_MAP = dataclasses.replace(
     MAP,
-    sidewalks=(Area("w", shapely.box(-6, 0, -3.5, 100)),),
+    sidewalks=(Area("w", shapely.box(-6, 0, -3.5, 100), centreline=np.array([[-4.75, 0], [-4.75, 100]])),),
     shoulders=(Area("h", shapely.box(7, 0, 9.5, 100)),),
     unknown_layers=frozenset(),
 )
-"""The synthetic map with sidewalks and shoulders, publishing every layer."""
+"""The synthetic map with sidewalks (oriented north) and shoulders, publishing every layer."""
 
 
 @cache

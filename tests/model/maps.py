@@ -3,7 +3,8 @@
 Three straight lanes 100 m long along y: ``n1`` (x 0..3.5, northbound), ``n2``
 (x 3.5..7, northbound, right of n1) and ``s1`` (x -3.5..0, southbound); ``n1`` is
 followed by ``n1b`` (y 100..200); a crossing lane ``x1`` (y 50..53.5, eastbound)
-overlaps all three and is an intersection lane; a crosswalk covers y 60..63. The map publishes
+overlaps all three and is an intersection lane; a crosswalk covers y 60..63, its centreline running
+east (Scenic orients it that way). The map publishes
 no sidewalks or shoulders (those layers are unknown); its crosswalks and curbs are as given.
 """
 
@@ -34,7 +35,7 @@ def synthetic_map() -> RoadMap:
         lanes,
         roads=(Area("r", box(-3.5, 0, 7, 100), ("n1", "n2", "s1")),),
         intersections=(Area("i", box(-3.5, 50, 7, 53.5), ("x1",)),),
-        crosswalks=(Area("c", box(-3.5, 60, 7, 63)),),
+        crosswalks=(Area("c", box(-3.5, 60, 7, 63), centreline=np.array([[-3.5, 61.5], [7, 61.5]])),),
         curbs=(np.array([[-3.5, 0], [-3.5, 100]]),),
         unknown_layers=frozenset({"sidewalk", "shoulder"}),
     )

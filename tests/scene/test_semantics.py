@@ -80,12 +80,15 @@ def test_a_default_region_in_an_unknown_layer_is_an_error_or_the_users_choice():
     # permissive: sidewalks everywhere; strict: no sidewalks, so only the crosswalk holds it
     assert matches(program, on_crosswalk, off_crosswalk) == [True, True]
     assert matches(program, on_crosswalk, off_crosswalk, unknown_layers=UnknownLayers("strict")) == [True, False]
-    # crossings alone are published: no choice needed (the car's default road-or-shoulder needs shoulders)
+    # crossings alone are published: no choice needed (the car's default road-or-shoulder needs shoulders);
+    # 'on' the crossings sets the parent orientation to theirs (east), over the class's random default
     program = (
         "ego = new Car on road, with regionContainedIn None\n"
         "ped = new Pedestrian on network.crossingRegion, with regionContainedIn None"
     )
-    assert matches(program, on_crosswalk, off_crosswalk, unknown_layers=None) == [True, False]
+    along = {"ego": EGO, "p": ("Pedestrian", 2.0, 61.5, EAST)}
+    off_along = {"ego": EGO, "p": ("Pedestrian", 2.0, 70.0, EAST)}
+    assert matches(program, along, off_along, on_crosswalk, unknown_layers=None) == [True, False, False]
 
 
 # ---------------------------------------------------------------------------- relative placement

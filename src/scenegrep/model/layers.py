@@ -4,6 +4,8 @@ A layer a map's format publishes but this map holds no element of is *empty* (as
 layer the format does not publish (:attr:`RoadMap.unknown_layers`) is *unknown*: a query or
 labelling rule that needs it is an error naming the layer, unless the user chose how to treat
 it: ``permissive`` (the layer is everywhere: anything goes) or ``strict`` (the layer is empty).
+The same choice covers the direction of sidewalks and crossings on a map that does not give it (no
+centrelines): permissive takes it as any heading, strict as none (nothing oriented by it matches).
 The choice counts, per layer, the decisions its assumption affected (those whose answer would
 differ under the other assumption), for the report on stderr.
 """
@@ -49,6 +51,19 @@ class UnknownLayers:
         return UserError(
             f"the road map {map_name!r} does not publish {what}, which {needed_by} needs; "
             f"say how to treat unknown layers with {OPTION} {'|'.join(MODES)}",
+            location,
+        )
+
+    def refuse_direction(
+        self, layers: Iterable[str], needed_by: str, map_name: str, location: SourceLocation | None = None
+    ) -> UserError:
+        """The error for a decision that needs the direction of the elements of ``layers``
+        (``sidewalk``, ``crossing``: Scenic orients them along their centrelines), which the map
+        does not give, without a choice."""
+        what = " and ".join(f"{layer}s" for layer in sorted(layers))
+        return UserError(
+            f"the road map {map_name!r} does not give the direction of its {what} (no centrelines), "
+            f"which {needed_by} needs; say how to treat unknown layers with {OPTION} {'|'.join(MODES)}",
             location,
         )
 

@@ -133,7 +133,8 @@ class ScenarioQuery:
         automata = self.automata(obs.period)
         ids = trace.objects.id
 
-        groups = self.scene.groups_for(trace)
+        scene = self.scene.for_map(geometry)
+        groups = scene.groups_for(trace)
 
         def scene_options(correspondence: dict[str, str], starts: np.ndarray) -> SceneOptions:
             return SceneOptions(
@@ -148,13 +149,13 @@ class ScenarioQuery:
             if not decided:
                 return starts
             correspondence = {name: str(ids[row]) for name, row in assignment.items()}
-            matching = self.scene.frames_matching(trace, geometry, scene_options(correspondence, starts), decided)
+            matching = scene.frames_matching(trace, geometry, scene_options(correspondence, starts), decided)
             return starts[matching[starts]]
 
         def scene_at(correspondence: dict[str, str], starts: np.ndarray) -> SceneResult:
             scene_options_at = scene_options(correspondence, starts)
-            matches = match_trace(self.scene.program, groups, trace, geometry, scene_options_at)
-            return SceneResult(trace, self.scene, matches, labels_of(trace), geometry, scene_options_at)
+            matches = match_trace(scene.program, groups, trace, geometry, scene_options_at)
+            return SceneResult(trace, scene, matches, labels_of(trace), geometry, scene_options_at)
 
         kinds = {name: objects[name].kinds for name in self.hfsms}
         search = Search(self.hfsms, kinds, self.guards, automata, obs, m, scene_starts, options.find_all)
@@ -222,7 +223,8 @@ def compile_scenario(
     soft = [r for r in scene.requirements if r.soft]
     translator = Translator(resolver, vocabulary or load_vocabulary())
     hfsms = {obj.name: translator.hfsm(obj) for obj in scene.objects}
-    return ScenarioQuery(SceneQuery(scene, analyse(scene), soft), hfsms, translator.guards, translator.vocabulary)
+    scene_query = SceneQuery(scene, analyse(scene), soft, visible_distance)
+    return ScenarioQuery(scene_query, hfsms, translator.guards, translator.vocabulary)
 
 
 def load_scenario(

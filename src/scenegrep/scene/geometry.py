@@ -40,8 +40,10 @@ from ..errors import UserError
 from ..model import RoadMap
 from ..model.geometry import box_corners
 from ..model.layers import UnknownLayers
+from ..model.polylines import Polylines
 from . import shapes
 from .regions import (
+    ELEMENT_FIELDS,
     Difference,
     Everywhere,
     Field,
@@ -62,6 +64,11 @@ Values = Callable[[Term], np.ndarray]
 
 CURB_REACH_M = 1e-6
 """A point is on a curb when it lies within this distance of a curb polyline."""
+
+ELEMENT_REACH_M = 0.05
+"""Scenic's road-network tolerance (``Network.fromOpenDrive``'s default): a point in no sidewalk
+or crossing takes the direction of the first within this distance (Scenic's union of them is
+built with this buffer, and its orientation tries that tolerance next)."""
 
 GEOMETRY_CACHE_SIZE = 8
 """How many road maps' geometries :func:`geometry_of` keeps (least recently used dropped)."""
@@ -95,6 +102,7 @@ class MapGeometry:
             road_map is not None and road_map.drivable_area is not None and not road_map.publishes("shoulder")
         )
         self._static: dict[Region, shapely.Geometry | None] = {}
+        self._element_cache: dict[str, tuple[STRtree, Polylines]] = {}
 
     # ---------------------------------------------------------------- layers
     def unknown_needed(self, region: Region) -> set[str]:
@@ -363,12 +371,23 @@ class MapGeometry:
             return np.min([self._distances(p, x, y) for p in region.parts], axis=0)
         raise UserError(f"the distance to {_describe(region)} is not supported")
 
+    def unoriented(self, field: Field) -> set[str]:
+        """The layers (``sidewalk``, ``crossing``) whose elements' directions ``field`` reads and
+        the map does not give (an unknown layer, or elements without centrelines)."""
+        if self.map is None or not (isinstance(field, MapField) and field.name in ELEMENT_FIELDS):
+            return set()
+        return {layer for layer in ELEMENT_FIELDS[field.name] if not self.map.orients(layer)}
+
     def field_values(self, field: Field, x: np.ndarray, y: np.ndarray, value: Values) -> tuple[np.ndarray, np.ndarray]:
         """The possible headings of a field at each point, as (row index, heading) pairs sorted by row.
 
-        Every row has at least one value when the map has lanes (or curbs, for the curb field).
+        Every row has at least one value when the map has lanes (or curbs, for the curb field; or
+        elements, for the sidewalk and crossing fields: under ``--unknown-layers strict`` a field the
+        map does not give has none).
         """
         road_map = self._require_map()
+        if isinstance(field, MapField) and field.name in ELEMENT_FIELDS:
+            return self._element_directions(field, x, y)
         if isinstance(field, MapField) and field.name == "curb":
             if not len(road_map.curb_polylines):
                 raise UserError("the query uses the curb, but the road map has no curbs")
@@ -383,6 +402,45 @@ class MapGeometry:
         if len(missing):
             rows, headings = _off_lane(road_map, x, y, missing, rows, headings)
         return rows, headings
+
+    def _elements(self, name: str) -> tuple[STRtree, Polylines]:
+        """An R-tree of the polygons of the elements giving the field ``name`` (one of
+        :data:`.regions.ELEMENT_FIELDS`, which the map gives) and their centrelines, in Scenic's
+        order (sidewalks, then crossings); built once."""
+        if name not in self._element_cache:
+            road_map = self._require_map()
+            held = {"sidewalk": road_map.sidewalks, "crossing": road_map.crosswalks}
+            areas = [a for layer in ELEMENT_FIELDS[name] for a in held[layer]]
+            polygons = np.array([a.polygon for a in areas], dtype=object)
+            lines = Polylines([a.centreline for a in areas if a.centreline is not None])
+            self._element_cache[name] = (STRtree(polygons), lines)
+        return self._element_cache[name]
+
+    def _element_directions(self, field: MapField, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Scenic's orientation of sidewalks, crossings or both at each point: the direction of the
+        first element containing it, else of the first within :data:`ELEMENT_REACH_M`, else of the
+        nearest (a labeled point off every element, where Scenic rejects: the nearest stands for
+        the element Scenic's point was in), each the heading of its centreline's segment nearest
+        by projection. No value on a map without elements, or (strict) without their directions."""
+        missing = self.unoriented(field)
+        if missing:
+            if self.choice.mode != "strict":
+                map_name = self.map.name if self.map is not None else "?"
+                raise self.choice.refuse_direction(missing, "a region's orientation in the query", map_name)
+            return np.zeros(0, np.intp), np.zeros(0)
+        tree, lines = self._elements(field.name)
+        if not len(lines):
+            return np.zeros(0, np.intp), np.zeros(0)
+        points = shapely.points(x, y)
+        element = np.full(len(x), len(lines), dtype=np.intp)
+        for predicate, reach in (("intersects", 0.0), ("dwithin", ELEMENT_REACH_M)):
+            open_rows = np.flatnonzero(element == len(lines))
+            point, found = tree.query(points[open_rows], predicate=predicate, distance=reach or None)
+            np.minimum.at(element, open_rows[point], found)
+        open_rows = np.flatnonzero(element == len(lines))
+        if len(open_rows):
+            element[open_rows] = tree.nearest(points[open_rows])
+        return np.arange(len(x)), lines.direction_at(element, x, y)
 
     def _uniform_headings(
         self, field: Field, x0: float, x1: float, y0: float, y1: float, value: Values
@@ -466,7 +524,10 @@ class MapGeometry:
         A point's heading is that of the segment of a polyline (lane centreline or curb) nearest to
         it; for any point of the box that segment lies within d + 2h of the box centre, where d is
         the centre's distance to the polyline and h the half-diagonal, so those segments' headings
-        cover every point of the box.
+        cover every point of the box. A sidewalk or crossing field takes the centreline of an
+        element meeting the box, within :data:`ELEMENT_REACH_M` of one of its points, or nearest to
+        one: every such element lies within max(d + 2h, reach + h) of the centre, d the distance
+        to the nearest element.
         """
         road_map = self._require_map()
         cx, cy, h = (x0 + x1) / 2, (y0 + y1) / 2, math.hypot(x1 - x0, y1 - y0) / 2
@@ -477,7 +538,14 @@ class MapGeometry:
             if uniform is not None:
                 return uniform
         centre = shapely.Point(cx, cy)
-        if isinstance(field, MapField) and field.name == "curb":
+        if isinstance(field, MapField) and field.name in ELEMENT_FIELDS:
+            if self.unoriented(field) or not len(self._elements(field.name)[1]):
+                return self._element_directions(field, np.array([cx]), np.array([cy]))[1]
+            tree, polylines = self._elements(field.name)
+            nearest = shapely.distance(tree.geometries[tree.nearest(centre)], centre)
+            reach = max(nearest + 2 * h, ELEMENT_REACH_M + h)
+            lines = tree.query(centre, predicate="dwithin", distance=reach)
+        elif isinstance(field, MapField) and field.name == "curb":
             polylines, tree = road_map.curb_polylines, self._trees["curb"]
             nearest = shapely.distance(tree.geometries[tree.nearest(centre)], centre)
             lines = tree.query(centre, predicate="dwithin", distance=nearest + 2 * h)

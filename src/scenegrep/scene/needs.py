@@ -5,9 +5,11 @@ A program part (an object's feature, a requirement, a scenario guard) that reads
 pedestrian's container (sidewalks and crossings), is an error naming the layer and the part,
 unless the user chose how to treat unknown layers. An object whose container region is empty on
 the map (Town06 has no sidewalks or crossings, so no walkable region) is refused, as Scenic 3.1.1
-refuses it ("Container region of ... is empty"). A curb direction (``on curb``) has no value to
-assume: on a map without curbs, unknown or empty, a program that reads it is refused whatever the
-choice.
+refuses it ("Container region of ... is empty"). A part that reads the direction of sidewalks or
+crossings (``on sidewalk`` orients an object along them) on a map that does not give it (no
+centrelines) is an error naming the part, unless the user chose how to treat unknown layers. A
+curb direction (``on curb``) has no value to assume: on a map without curbs, unknown or empty, a
+program that reads it is refused whatever the choice.
 """
 
 from __future__ import annotations
@@ -44,6 +46,11 @@ def check_layers(program: SceneProgram, geometry: MapGeometry, extra: Iterable[P
             if layers and geometry.choice.mode is None:
                 where = at(filename, span.line, span.column)
                 raise geometry.choice.refuse(layers, name, geometry.map.name, where)
+        for field in (v for v in values if isinstance(v, Field)):
+            layers = geometry.unoriented(field)
+            if layers and geometry.choice.mode is None:
+                where = at(filename, span.line, span.column)
+                raise geometry.choice.refuse_direction(layers, name, geometry.map.name, where)
     for requirement in program.requirements:
         if requirement.container_of is None:
             continue
@@ -64,6 +71,15 @@ def program_parts(program: SceneProgram) -> Iterator[Part]:
             yield feature.term, f"the {feature.name} of {obj.class_name} {obj.name}", feature.span
     for requirement in program.requirements:
         yield requirement.condition, f"the requirement '{requirement.description}'", requirement.span
+
+
+def free_fields(program: SceneProgram, geometry: MapGeometry) -> frozenset[str]:
+    """The map fields the program reads whose values the map does not give, taken as free
+    headings (``--unknown-layers permissive``); empty under any other choice."""
+    if not geometry.choice.everywhere:
+        return frozenset()
+    values = (v for term, _, _ in program_parts(program) for v in term_values(term))
+    return frozenset(v.name for v in values if isinstance(v, MapField) and geometry.unoriented(v))
 
 
 def term_regions(term: Term) -> list[Region]:

@@ -12,7 +12,7 @@ here, else the program's ``param map``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 from typing import Any
@@ -27,7 +27,7 @@ from .dependencies import Group, analyse
 from .geometry import MapGeometry, geometry_of
 from .evaluate import Labels
 from .explain import soft_requirements, witness_values
-from .needs import check_layers, term_regions
+from .needs import check_layers, free_fields, term_regions
 from .match import SceneOptions, TraceMatches, labels_of, match_trace
 from .program import Requirement, SceneProgram
 from .resolve import Resolver
@@ -82,11 +82,14 @@ class SceneResult:
 
 @dataclass
 class SceneQuery:
-    """A compiled scene program: resolved features, their groups in order, soft requirements."""
+    """A compiled scene program: resolved features, their groups in order, soft requirements, and
+    the visible distance (m) it was compiled with."""
 
     program: SceneProgram
     groups: list[Group]
     soft: list[Requirement]
+    visible_distance: float | None = None
+    _variants: dict[frozenset[str], SceneQuery] = field(default_factory=dict, repr=False)
 
     def describe_group(self, group: Group) -> str:
         """Why a frame fails at a group: the objects no label object can be, and what fails."""
@@ -122,9 +125,24 @@ class SceneQuery:
         road_map = self._map_for(trace, road_map)
         geometry = geometry_of(road_map, options.unknown_layers)
         check_layers(self.program, geometry)
-        groups = self.groups_for(trace)
-        matches = match_trace(self.program, groups, trace, geometry, options)
-        return SceneResult(trace, self, matches, labels_of(trace), geometry, options)
+        query = self.for_map(geometry)
+        groups = query.groups_for(trace)
+        matches = match_trace(query.program, groups, trace, geometry, options)
+        return SceneResult(trace, query, matches, labels_of(trace), geometry, options)
+
+    def for_map(self, geometry: MapGeometry) -> SceneQuery:
+        """The query to match on ``geometry``'s map: this one, except where the program reads a
+        sidewalk or crossing direction the map does not give and the user chose ``--unknown-layers
+        permissive``: then the program resolved again with those directions free headings (built
+        once per set of such fields)."""
+        free = free_fields(self.program, geometry)
+        if not free:
+            return self
+        if free not in self._variants:
+            scene = Resolver(self.program.program, self.visible_distance, free).run()
+            soft = [r for r in scene.requirements if r.soft]
+            self._variants[free] = SceneQuery(scene, analyse(scene), soft, self.visible_distance)
+        return self._variants[free]
 
     def _map_for(self, trace: LabelTrace, road_map: RoadMap | None) -> RoadMap | None:
         return self.map_for(trace, road_map, self.uses_map())
@@ -176,7 +194,7 @@ def compile_scene(text: str, filename: str = "<program>", visible_distance: floa
     resolver = Resolver(program, visible_distance=visible_distance)
     scene = resolver.run()
     soft = [r for r in scene.requirements if r.soft]
-    return SceneQuery(scene, analyse(scene), soft)
+    return SceneQuery(scene, analyse(scene), soft, visible_distance)
 
 
 def load_scene(path: str | Path, visible_distance: float | None = None) -> SceneQuery:

@@ -25,9 +25,20 @@ LAYERS = ("drivable", "road", "lane", "intersection", "crossing", "sidewalk", "c
 """Map layers a region can name. ``road`` is the road polygons without intersections
 (Scenic's ``network.roadRegion``); ``drivable`` is Scenic's ``road``."""
 
-ORIENTED_LAYERS = {"drivable": "lanes", "road": "lanes", "lane": "lanes", "intersection": "lanes", "curb": "curb"}
-"""Layers with a preferred orientation the map knows, and the field giving it. Sidewalks and
-crossings have one in Scenic (their centreline) that the data model does not hold."""
+ORIENTED_LAYERS = {
+    "drivable": "lanes",
+    "road": "lanes",
+    "lane": "lanes",
+    "intersection": "lanes",
+    "curb": "curb",
+    "sidewalk": "sidewalk",
+    "crossing": "crossing",
+}
+"""Layers with a preferred orientation, and the field giving it."""
+
+ELEMENT_FIELDS = {"sidewalk": ("sidewalk",), "crossing": ("crossing",), "walkable": ("sidewalk", "crossing")}
+"""Fields given by the centrelines of map elements, and their layers in Scenic's order: a point
+takes the direction of the first element containing it (``VectorField.forUnionOf``)."""
 
 
 class Region:
@@ -136,6 +147,11 @@ class Difference(Region):
         yield from self.removed.layers()
 
 
+WALKABLE = Union((MapRegion("sidewalk"), MapRegion("crossing")))
+"""Scenic's ``network.walkableRegion`` (sidewalks, then crossings); its orientation is the
+``walkable`` field."""
+
+
 class Field:
     """Base of vector-field values: a heading at each point."""
 
@@ -146,8 +162,9 @@ class Field:
 @dataclass(frozen=True)
 class MapField(Field):
     """A heading field of the map: ``lanes`` (the direction of travel of the lanes containing the
-    point, Scenic's ``roadDirection`` and the orientation of road, lane and intersection regions)
-    or ``curb`` (the direction of the curb segment at the point)."""
+    point, Scenic's ``roadDirection`` and the orientation of road, lane and intersection regions),
+    ``curb`` (the direction of the curb segment at the point), or one of :data:`ELEMENT_FIELDS`
+    (the orientation of the sidewalks, the crossings, the walkable region)."""
 
     name: str
 
@@ -166,8 +183,9 @@ class LaneDirection(Field):
 
 def orientation_of(region: Region) -> Field | None:
     """The preferred orientation of a region, or None (Scenic: the first oriented part of an
-    intersection; sectors and discs have none). Unknown orientations (sidewalks, crossings)
-    are reported by :func:`has_unknown_orientation`."""
+    intersection; sectors and discs have none)."""
+    if region == WALKABLE:
+        return MapField("walkable")
     if isinstance(region, MapRegion):
         name = ORIENTED_LAYERS.get(region.layer)
         return None if name is None else MapField(name)
@@ -181,14 +199,3 @@ def orientation_of(region: Region) -> Field | None:
     if isinstance(region, Difference):
         return orientation_of(region.base)
     return None
-
-
-def has_unknown_orientation(region: Region) -> bool:
-    """Whether Scenic gives the region an orientation the map does not hold (sidewalks, crossings)."""
-    if isinstance(region, MapRegion):
-        return region.layer in ("sidewalk", "crossing")
-    if isinstance(region, (Intersection, Union)):
-        return orientation_of(region) is None and any(has_unknown_orientation(p) for p in region.parts)
-    if isinstance(region, Difference):
-        return has_unknown_orientation(region.base)
-    return False

@@ -19,7 +19,7 @@ from ..scenic.errors import program_error
 from . import expressions
 from .domain import MODELS, Default
 from .program import TRACE, Requirement, SceneProgram
-from .regions import Everywhere, MapField, MapRegion, Nowhere, Union
+from .regions import WALKABLE, Everywhere, MapField, MapRegion, Nowhere, Union
 from .terms import Term
 from .values import Instance, Namespace
 
@@ -38,7 +38,7 @@ NETWORK = {
     "intersectionRegion": MapRegion("intersection"),
     "crossingRegion": MapRegion("crossing"),
     "sidewalkRegion": MapRegion("sidewalk"),
-    "walkableRegion": Union((MapRegion("sidewalk"), MapRegion("crossing"))),
+    "walkableRegion": WALKABLE,
     "curbRegion": MapRegion("curb"),
     "shoulderRegion": MapRegion("shoulder"),
     "roadDirection": MapField("lanes"),
@@ -67,9 +67,14 @@ webots and GTA world models."""
 class Resolver:
     """Resolves one program; see the module docstring. Use :func:`resolve`."""
 
-    def __init__(self, program: ir.Program, visible_distance: float | None = None):
+    def __init__(
+        self, program: ir.Program, visible_distance: float | None = None, free_fields: frozenset[str] = frozenset()
+    ):
         self.program = program
         self.visible_distance = visible_distance
+        self.free_fields = free_fields
+        """Names of map fields (:class:`.regions.MapField`) whose values are free headings: a
+        region oriented by one gives objects an unconstrained parent orientation."""
         self.scene = SceneProgram(program)
         self.f = self.scene.factory
         self.scope: dict[str, Any] = {}

@@ -33,8 +33,8 @@ from .regions import (
     Field,
     Intersection,
     Region,
+    MapField,
     Sector,
-    has_unknown_orientation,
     orientation_of,
 )
 from .terms import RandomPoint, RandomVariable, Term
@@ -350,17 +350,19 @@ def _own_position(view: Any, point: Vec) -> Vec:
 
 
 def _orientation_value(r: Resolver, region: Region, position: Vec, node: ir.Node) -> Term:
-    """The region's preferred orientation at ``position``."""
-    if has_unknown_orientation(region):
-        name = f"orientation of the region: {r.label(node)}"
-        return r.f.var(RandomVariable(name, r.f.const(-math.inf), r.f.const(math.inf), node.span))
+    """The region's preferred orientation at ``position``; a heading free over the reals where the
+    resolver takes the field as unknown and unconstrained (``r.free_fields``: ``--unknown-layers
+    permissive`` on a map that does not give it)."""
     field_value = orientation_of(region)
     assert field_value is not None
+    if isinstance(field_value, MapField) and field_value.name in r.free_fields:
+        name = f"orientation of the region: {r.label(node)}"
+        return r.f.var(RandomVariable(name, r.f.const(-math.inf), r.f.const(math.inf), node.span))
     return E.field_at(r, field_value, position)
 
 
 def _is_oriented_region(region: Region) -> bool:
-    return orientation_of(region) is not None or has_unknown_orientation(region)
+    return orientation_of(region) is not None
 
 
 def _in(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:

@@ -59,7 +59,8 @@ class PointEvaluator:
         args = [self.array(a) for a in term.args]
         g = self.geometry
         if term.op == "field":
-            return float(g.field_values(term.value, args[0], args[1], self.array)[1][0])
+            headings = g.field_values(term.value, args[0], args[1], self.array)[1]
+            return float(headings[0]) if len(headings) else math.nan  # no value: no heading fits
         if term.op == "in_region":
             return bool(g.contains_points(term.value, args[0], args[1], self.array)[0])
         if term.op == "region_distance":

@@ -5,6 +5,7 @@ import math
 from dataclasses import replace
 
 import numpy as np
+import pyarrow as pa
 import pytest
 import shapely
 from hypothesis import given
@@ -83,6 +84,26 @@ def test_map_table_round_trips_the_unknown_layers():
     published = replace(ROAD_MAP, unknown_layers=frozenset())
     assert map_from_table(map_to_table(published)).equals(published)
     assert not map_from_table(map_to_table(published)).equals(ROAD_MAP)
+
+
+def test_map_table_round_trips_the_crosswalk_centrelines():
+    again = map_from_table(map_to_table(ROAD_MAP))
+    assert np.array_equal(again.crosswalks[0].centreline, [[-3.5, 61.5], [7, 61.5]])
+    assert again.orients("crossing") and not again.orients("sidewalk")  # sidewalks: an unknown layer
+    without = replace(ROAD_MAP, crosswalks=(replace(ROAD_MAP.crosswalks[0], centreline=None),))
+    assert not without.equals(ROAD_MAP)
+    assert map_from_table(map_to_table(without)).equals(without) and not without.orients("crossing")
+
+
+def test_an_older_map_table_has_no_crosswalk_centrelines_so_their_direction_is_unknown():
+    """Files written before centrelines were kept have a null centreline in crosswalk rows."""
+    table = map_to_table(ROAD_MAP)
+    rows = table.to_pylist()
+    for row in rows:
+        if row["kind"] == "crosswalk":
+            row["centreline"] = None
+    older = pa.Table.from_pylist(rows, schema=table.schema)
+    assert not map_from_table(older).orients("crossing")
 
 
 def test_an_older_map_table_has_the_optional_layers_it_holds_nothing_of_unknown():

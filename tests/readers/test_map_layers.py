@@ -24,15 +24,21 @@ AV2_MAP = "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede/map"
 )
 def test_unknown_layers_per_format(real_data, path, unknown):
     trace = readers.read_trace(real_data / path)
-    assert readers.read_map(trace.map_source).unknown_layers == unknown
+    road_map = readers.read_map(trace.map_source)
+    assert road_map.unknown_layers == unknown
+    # none of these formats has sidewalk or crosswalk centrelines: their direction is unknown
+    assert not road_map.orients("sidewalk") and not road_map.orients("crossing")
 
 
 def test_av2_publishes_crossings_and_a_drivable_area_only(real_data):
     road_map = readers.read_map(next((real_data / AV2_MAP).glob("log_map_archive_*.json")))
     assert road_map.unknown_layers == {"sidewalk", "curb", "shoulder"}
     assert road_map.crosswalks and road_map.drivable_area is not None
+    assert not road_map.orients("crossing")  # AV2 crossings have edges, no centreline: direction unknown
 
 
 def test_opendrive_publishes_every_layer(maps_dir):
     town06 = readers.read_map(maps_dir / "Town06.xodr")
     assert not town06.unknown_layers and not town06.sidewalks and not town06.crosswalks
+    # empty layers: their (empty) sets of directions are known
+    assert town06.orients("sidewalk") and town06.orients("crossing")

@@ -101,3 +101,26 @@ def test_the_initial_scene_takes_the_same_rule():
     # a map that publishes both layers and holds neither has no walkable region: refused, as Scenic does
     with pytest.raises(UserError, match="the container region .* of Pedestrian ped is empty"):
         run(EMPTY, None)
+
+
+def test_the_initial_scene_takes_the_crossings_direction_by_the_same_rule():
+    # the pedestrian stands on a crosswalk facing north; 'on crossing' orients it along the crosswalk:
+    # a centreline running north decides it, one running east refuses it; without a centreline the
+    # direction is unknown: an error without a choice, any heading (permissive) or none (strict)
+    program = PROGRAM.replace(
+        "ped = new Pedestrian on road, facing Range(-180, 180) deg,", "ped = new Pedestrian on crossing,"
+    ).replace("with behavior WaitToCross()", "with behavior StationaryBehavior()")
+    query = compile_scenario(program, "wait.scenic")
+    here = shapely.box(-1, -2, 1, 2)
+
+    def run(centreline, mode=None):
+        road_map = replace(worked_map(), crosswalks=(Area("c", here, centreline=centreline),))
+        options = ScenarioOptions(unknown_layers=UnknownLayers(mode))
+        return query.match(waiting_trace(), "all", road_map, options).matched
+
+    assert run(np.array([[0.0, -2], [0, 2]]))
+    assert not run(np.array([[-1.0, 0], [1, 0]]))
+    with pytest.raises(UserError, match=r"wait.scenic:6:7: .*does not give the direction of its crossings"):
+        run(None)
+    assert run(None, "permissive")
+    assert not run(None, "strict")

@@ -421,12 +421,14 @@ class MapGeometry:
         first element containing it, else of the first within :data:`ELEMENT_REACH_M`, else of the
         nearest (a labeled point off every element, where Scenic rejects: the nearest stands for
         the element Scenic's point was in), each the heading of its centreline's segment nearest
-        by projection. No value on a map without elements, or (strict) without their directions."""
+        by projection. No value on a map without elements, or (strict) without their directions:
+        then the rows are counted as decisions of the choice (each refused by it)."""
         missing = self.unoriented(field)
         if missing:
             if self.choice.mode != "strict":
                 map_name = self.map.name if self.map is not None else "?"
                 raise self.choice.refuse_direction(missing, "a region's orientation in the query", map_name)
+            self.choice.count(f"{'+'.join(sorted(missing))} direction", len(x))
             return np.zeros(0, np.intp), np.zeros(0)
         tree, lines = self._elements(field.name)
         if not len(lines):
@@ -540,7 +542,7 @@ class MapGeometry:
         centre = shapely.Point(cx, cy)
         if isinstance(field, MapField) and field.name in ELEMENT_FIELDS:
             if self.unoriented(field) or not len(self._elements(field.name)[1]):
-                return self._element_directions(field, np.array([cx]), np.array([cy]))[1]
+                return self._element_directions(field, np.zeros(0), np.zeros(0))[1]  # none (or the error)
             tree, polylines = self._elements(field.name)
             nearest = shapely.distance(tree.geometries[tree.nearest(centre)], centre)
             reach = max(nearest + 2 * h, ELEMENT_REACH_M + h)

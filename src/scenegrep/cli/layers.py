@@ -19,7 +19,9 @@ def add_unknown_layers_argument(parser: argparse.ArgumentParser) -> None:
         default=None,
         help="how to treat map layers the map's format does not publish (nuScenes has no crosswalks, "
         "AV2 no sidewalks): as everywhere (permissive) or empty (strict); without it a query or label "
-        "rule that needs one is an error. The number of decisions the choice affected is printed on stderr",
+        "rule that needs one is an error; likewise a sidewalk or crosswalk direction the map does not give "
+        "(only OpenDRIVE maps give it): any heading (permissive) or none (strict). The number of decisions "
+        "the choice affected is printed on stderr",
     )
 
 

@@ -59,6 +59,7 @@ CREATE TABLE IF NOT EXISTS results (
     correspondence VARCHAR, start_frame BIGINT, end_frame BIGINT, start_time DOUBLE, end_time DOUBLE,
     time_origin_ns BIGINT, explanation VARCHAR, error VARCHAR);
 ALTER TABLE results ADD COLUMN IF NOT EXISTS values VARCHAR;
+ALTER TABLE results ADD COLUMN IF NOT EXISTS objects VARCHAR;
 """
 
 PER_TRACE_TABLES = ("objects", "frame_counts", "labels")

@@ -11,7 +11,10 @@ and last frame, inclusive), ``start_time``/``end_time`` (seconds from the trace'
 ``time_origin_ns`` (the trace's absolute time 0), ``explanation`` (with ``explain``: the
 witness of a match or why the trace does not match; for pruned traces, why), ``error``, and
 ``values`` (scene matches with ``values``: JSON object of the program's random variables' values
-that reproduce the frame, and each soft requirement's truth).
+that reproduce the frame, and each soft requirement's truth), and ``objects`` (JSON object,
+program object -> ``{"id", "start_frame", "end_frame", "start_time", "end_time"}``: the labeled
+object it corresponds to and the frames, inclusive, and times (s) in which it is involved; see
+:func:`involvement`).
 
 One trace's rows come from :func:`query_trace` whether the trace was ingested (a dataset run)
 or read from a file (:mod:`scenegrep.dataset.files`).
@@ -49,6 +52,7 @@ RESULTS_SCHEMA = pa.schema(
         ("explanation", pa.string()),
         ("error", pa.string()),
         ("values", pa.string()),
+        ("objects", pa.string()),
     ]
 )
 
@@ -179,12 +183,24 @@ def match_trace(spec: QuerySpec, trace: LabelTrace, road_map: RoadMap | None) ->
 
 def _window(trace: LabelTrace, match: int, first: int, last: int, correspondence: Any) -> dict[str, Any]:
     """A match row: frames at positions first..last (inclusive) of ``trace``."""
+    span = _span(trace, first, last)
     return {
         "status": "match",
         "match": match,
         "correspondence": json.dumps(correspondence or {}, sort_keys=True),
-        **_span(trace, first, last),
+        **span,
+        "objects": json.dumps(involvement(correspondence or {}, span)),
     }
+
+
+def involvement(correspondence: dict[str, Any], span: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Each program object of a match -> the labeled object it
+    corresponds to (``id``) and the frames and times in which it is involved: the match's
+    whole ``span`` (frame-range columns) for every kind of query. A scenario window requires
+    every corresponded object in each of its frames, a scene match is one frame, and a SpRE's
+    track binder names the object whose instantiation matches the whole stretch (the SpRE
+    engine does not say in which frames the binder's sub-expression held)."""
+    return {str(name): {"id": str(label), **span} for name, label in correspondence.items()}
 
 
 def _span(trace: LabelTrace, first: int, last: int) -> dict[str, Any]:

@@ -128,10 +128,10 @@ class Results:
             pq.write_table(self.table.replace_schema_metadata(metadata), tmp, compression="zstd")
 
 
-LATER_COLUMNS = ("values",)
+LATER_COLUMNS = ("values", "objects")
 """Columns added after results files were first written: null when a file lacks them."""
 
-JSON_COLUMNS = ("correspondence", "values")
+JSON_COLUMNS = ("correspondence", "values", "objects")
 """Columns holding JSON text, written as JSON values in JSON lines."""
 
 

@@ -65,7 +65,18 @@ def test_the_column_travels_through_json_csv_and_parquet(tmp_path, capsys):
     assert main(["spre", "E(c := [:car:]) ([@x(c) > 300][@x(c) > 300])", str(SAMPLE), "--csv"]) == 0
     (tmp_path / "r.csv").write_text(capsys.readouterr().out)
     assert Results.read(tmp_path / "r.csv").table.equals(from_json.table)
-    assert main(["spre", "E(c := [:car:]) ([@x(c) > 300][@x(c) > 300])", str(SAMPLE), "--output", str(tmp_path / "r.parquet")]) == 0
+    assert (
+        main(
+            [
+                "spre",
+                "E(c := [:car:]) ([@x(c) > 300][@x(c) > 300])",
+                str(SAMPLE),
+                "--output",
+                str(tmp_path / "r.parquet"),
+            ]
+        )
+        == 0
+    )
     assert Results.read(tmp_path / "r.parquet").table.equals(from_json.table)
 
 

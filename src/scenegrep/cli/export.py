@@ -1,35 +1,82 @@
-"""``scenegrep export RESULTS --mcap OUT.mcap``: a results table's matches as Foxglove events.
+"""``scenegrep export RESULTS (--mcap OUT.mcap | --refav OUT --prompt TEXT)``: a results table for
+other tools.
 
-RESULTS is a results Parquet file (``DATASET/runs/RUN/results.parquet`` or a run's
-``--output``) or a run directory. Exit codes: 0 written, 2 user error.
+RESULTS is a results table (Parquet, JSON lines or CSV) or a run directory. ``--mcap`` writes
+its matches as Foxglove events; ``--refav`` writes a RefAV scenario-mining submission
+(:mod:`scenegrep.dataset.refav_export`): RefAV's own pickle when OUT ends in ``.pkl``, the same
+data as JSON (which ``scenegrep evaluate`` reads) when it ends in ``.json``. Exit codes: 0
+written, 2 user error.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 from typing import Any
+
+from ..errors import UserError
 
 
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "export",
-        help="write a results table's matches for other viewers (Foxglove MCAP events)",
+        help="write a results table for other tools (Foxglove MCAP events, RefAV submission)",
         description="Write the matches of a results table as Foxglove events (schema foxglove.Event, topic "
         "/scenegrep/matches) in an MCAP file: each event spans the window's first to last frame at the "
-        "recording's absolute time, with the trace and the correspondence as metadata.",
+        "recording's absolute time, with the trace and the correspondence as metadata. Or, for results over "
+        "Argoverse 2 sensor logs, write a RefAV scenario-mining submission: per (log id, prompt), at every "
+        "2 Hz evaluation timestamp, the boxes of the tracks the referred program object corresponds to.",
     )
-    parser.add_argument("results", metavar="RESULTS", help="a results .parquet file or a run directory")
-    parser.add_argument("--mcap", required=True, metavar="OUT", help="the MCAP file to write")
+    parser.add_argument("results", metavar="RESULTS", help="a results table (.parquet/.json/.csv) or a run directory")
+    target = parser.add_mutually_exclusive_group(required=True)
+    target.add_argument("--mcap", metavar="OUT", help="the MCAP file to write")
+    target.add_argument("--refav", metavar="OUT", help="the RefAV submission to write: OUT.pkl (RefAV's) or OUT.json")
+    parser.add_argument("--prompt", metavar="TEXT", help="--refav: the RefAV prompt the query answers")
+    parser.add_argument(
+        "--referred",
+        metavar="NAME",
+        help="--refav: the program object the prompt refers to (default: the one besides ego)",
+    )
+    parser.add_argument(
+        "--dataset", metavar="DATASET", help="--refav: the dataset of the results (default: where they lie)"
+    )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.refav is not None:
+        return _refav(args)
+    if args.prompt is not None or args.referred is not None or args.dataset is not None:
+        raise UserError("--prompt, --referred and --dataset go with --refav")
     from ..dataset.export import write_mcap_events
     from ..dataset.results import Results
 
     count = write_mcap_events(Results.read(args.results), args.mcap)
     if not args.quiet:
         print(f"scenegrep: {count} matches written as Foxglove events to {args.mcap}", file=sys.stderr)
+    return 0
+
+
+def _refav(args: argparse.Namespace) -> int:
+    from ..dataset.refav_export import refav_sequences
+    from ..dataset.refav_format import write_sequences
+    from ..view.sources import ResultsSource
+
+    if Path(args.refav).suffix.lower() not in (".pkl", ".json"):
+        raise UserError(f"--refav {args.refav}: write a .pkl (RefAV's pickle) or a .json file")
+    if not args.prompt:
+        raise UserError("--refav needs --prompt TEXT: RefAV keys a submission by (log id, prompt)")
+    source = ResultsSource.open(args.results, args.dataset)
+    sequences = refav_sequences(source.results, lambda trace_id: source.load(trace_id)[0], args.prompt, args.referred)
+    write_sequences(sequences, args.refav)
+    if not args.quiet:
+        positive = sum(any(len(f.label) for f in frames) for frames in sequences.values())
+        frames = sum(len(frames) for frames in sequences.values())
+        print(
+            f"scenegrep: {len(sequences)} logs ({positive} with a referred track), {frames} evaluation timestamps "
+            f"written to {args.refav}",
+            file=sys.stderr,
+        )
     return 0

@@ -21,7 +21,20 @@ from .. import __version__  # noqa: E402
 from ..errors import UserError  # noqa: E402
 from ..terminal import EscapingStream, OutputError  # noqa: E402
 
-COMMANDS = ("export", "info", "ingest", "label", "report", "scenario", "scene", "serve", "show", "spre", "synth")
+COMMANDS = (
+    "evaluate",
+    "export",
+    "info",
+    "ingest",
+    "label",
+    "report",
+    "scenario",
+    "scene",
+    "serve",
+    "show",
+    "spre",
+    "synth",
+)
 """Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
 
 EXIT_USER_ERROR = 2

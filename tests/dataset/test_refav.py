@@ -436,7 +436,7 @@ def test_export_of_real_av2_logs_has_their_timestamps_and_boxes(real_data, tmp_p
     sequences = read_sequences(out)
     assert sorted(log for log, _ in sequences) == [log.name for log in logs]
     boxes = 0
-    for (log_id, prompt), frames in sequences.items():
+    for (log_id, _), frames in sequences.items():
         ann = feather.read_table(real_data / "av2" / "sensor" / log_id / "annotations.feather").to_pandas()
         poses = feather.read_table(real_data / "av2" / "sensor" / log_id / "city_SE3_egovehicle.feather").to_pandas()
         stamps = sorted(set(ann["timestamp_ns"].tolist()))

@@ -460,3 +460,31 @@ def test_export_of_real_av2_logs_has_their_timestamps_and_boxes(real_data, tmp_p
     code, text, _ = run(["evaluate", out, out, "--av2", real_data / "av2" / "sensor", "--json"], capsys)
     assert code == 0 and json.loads(text)["timestamp_balanced_accuracy"] == 1.0
     assert json.loads(text)["drivable_area_filter"] is True
+
+
+@pytest.mark.real_data
+def test_export_of_a_dataset_run_equals_the_export_over_files(real_data, tmp_path, capsys):
+    logs = real_data / "av2" / "sensor"
+    program = REPO / "examples" / "scenes" / "fig3_car_ahead.scenic"
+    options = ["--tolerance-profile", "av2", "--visible-distance", "50", "-q"]
+    assert run(["ingest", logs, "--into", tmp_path / "ds", "-q"], capsys)[0] == 0
+    assert run(["scene", program, "--dataset", tmp_path / "ds", *options], capsys)[0] == 0
+    (run_dir,) = (tmp_path / "ds" / "runs").iterdir()
+    assert run(["scene", program, logs, *options, "--output", tmp_path / "r.parquet"], capsys)[0] == 0
+    for results, out in ((run_dir, "ds.json"), (tmp_path / "r.parquet", "files.json")):
+        assert run(["export", results, "--refav", tmp_path / out, "--prompt", "p", "-q"], capsys)[0] == 0
+    assert json.loads((tmp_path / "ds.json").read_text()) == json.loads((tmp_path / "files.json").read_text())
+
+
+def test_the_readmes_pickle_conversion_gives_refav_json(tmp_path, monkeypatch):
+    """The README's snippet, run on a pickle scenegrep wrote, gives what ``--refav OUT.json`` gives."""
+    readme = (REPO / "README.md").read_text()
+    snippet = readme.split("To convert a pickle you trust", 1)[1].split("```python\n", 1)[1].split("```", 1)[0]
+    sequences = {("0" * 36, "a prompt"): [frame(0, boxes=[(1, 2, 0, "t")]), frame(500_000_000, A)]}
+    write_sequences(sequences, tmp_path / "gt.pkl")
+    monkeypatch.chdir(tmp_path)
+    exec(snippet, {})  # scenegrep wrote gt.pkl in this test
+    converted = read_sequences(tmp_path / "gt.json")
+    assert list(converted) == list(sequences)
+    for a, b in zip(converted[("0" * 36, "a prompt")], sequences[("0" * 36, "a prompt")]):
+        assert a.as_json() == b.as_json()

@@ -67,20 +67,6 @@ class RefFrame:
     name: np.ndarray
     is_positive: bool | None | str = UNSET
 
-    @classmethod
-    def empty(cls, timestamp_ns: int, ego_translation_m: np.ndarray) -> RefFrame:
-        """A frame without boxes."""
-        return cls(
-            timestamp_ns,
-            np.asarray(ego_translation_m, dtype=np.float64),
-            np.zeros((0, 3)),
-            np.zeros((0, 3)),
-            np.zeros(0),
-            np.zeros(0, dtype=np.int64),
-            np.zeros(0, dtype=str),
-            np.zeros(0, dtype=str),
-        )
-
     def keep(self, mask: np.ndarray) -> RefFrame:
         """The frame with only the boxes where ``mask`` is True."""
         return RefFrame(
@@ -116,7 +102,6 @@ class RefFrame:
         """The frame in scenegrep's RefAV JSON."""
         out: dict[str, Any] = {
             "timestamp_ns": int(self.timestamp_ns),
-            "ego_translation_m": self.ego_translation_m.tolist(),
             "translation_m": self.translation_m.reshape(-1, 3).tolist(),
             "size": self.size.reshape(-1, 3).tolist(),
             "yaw": self.yaw.tolist(),
@@ -124,6 +109,8 @@ class RefFrame:
             "track_id": self.track_id.astype(str).tolist(),
             "name": self.name.astype(str).tolist(),
         }
+        if np.isfinite(self.ego_translation_m).all():
+            out["ego_translation_m"] = self.ego_translation_m.tolist()
         if self.is_positive is not UNSET:
             out["is_positive"] = self.is_positive
         return out

@@ -246,6 +246,8 @@ def hostile(tmp_path):
         "text.json": (b"hello", "not JSON"),
         "list.json": (b"[]", "not RefAV JSON"),
         "label.json": (doc(label=["x"]).encode(), "frames[0].label: must be a list of whole numbers"),
+        "big.json": (doc(label=[2**64 - 1]).encode(), "frames[0].label: must be a list of whole numbers"),
+        "deep.json": (b"[" * 100_000 + b"]" * 100_000, "not JSON"),
         "rows.json": (doc(translation_m=[[1, 2]]).encode(), "translation_m[0]: must be a list of 3 finite numbers"),
         "count.json": (doc(yaw=[0, 1]).encode(), "frames[0].yaw: must be a list of 1 finite numbers"),
         "stamp.json": (doc(timestamp_ns=-1).encode(), "timestamp_ns: must be a whole number"),
@@ -387,6 +389,8 @@ def test_a_trace_without_a_match_gives_negative_frames():
         (results_of([{"status": "failed", "match": -1}]), av2_like(), "trace log-1 failed, so its answer is unknown"),
         (results_of([{"status": "no match", "match": -1}], "interrupted"), av2_like(), "the run is interrupted"),
         (results_of([match_row({"car": "zz"}, 100, 101)]), av2_like(), "has no object 'zz' that the results name"),
+        (results_of([match_row({"car": "c"}, 100, 101) | {"objects": "{"}]), av2_like(), "objects are not scenegrep's"),
+        (results_of([match_row({"car": "c"}, 100, 101) | {"objects": '{"car": 3}'}]), av2_like(), "not scenegrep's"),
     ],
 )
 def test_export_refuses_what_refav_cannot_be_given(results, trace, message):
@@ -488,3 +492,9 @@ def test_the_readmes_pickle_conversion_gives_refav_json(tmp_path, monkeypatch):
     assert list(converted) == list(sequences)
     for a, b in zip(converted[("0" * 36, "a prompt")], sequences[("0" * 36, "a prompt")]):
         assert a.as_json() == b.as_json()
+
+
+def test_a_row_written_before_the_objects_column_involves_its_objects_in_the_whole_match():
+    old = results_of([match_row({"ego": "ego", "car": "c"}, 104, 111) | {"objects": None}])
+    frames = refav_sequences(old, lambda _: av2_like(), "p")[("log-1", "p")]
+    assert [f.track_id.tolist() for f in frames] == [[], ["c"], ["c"]]

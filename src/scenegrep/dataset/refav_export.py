@@ -69,24 +69,31 @@ def _log_id(trace: LabelTrace) -> str:
 
 def _referred_span(row: dict[str, Any], referred: str | None) -> tuple[str, int, int]:
     """(track id, first and last dataset frame index) of a match row's referred object."""
-    objects = json.loads(row["objects"]) if row["objects"] else _objects_of_old_row(row)
+    try:
+        objects = json.loads(row["objects"]) if row["objects"] else _objects_of_old_row(row)
+        name = _referred_name(row, objects, referred)
+        found = objects[name]
+        return str(found["id"]), int(found["start_frame"]), int(found["end_frame"])
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+        raise UserError(f"match {row['match']} of {row['name']}: its objects are not scenegrep's ({exc})") from None
+
+
+def _referred_name(row: dict[str, Any], objects: dict[str, Any], referred: str | None) -> str:
+    """The program object of a match that the prompt refers to (module docstring)."""
     if referred is not None:
         if referred not in objects:
             raise UserError(
                 f"--referred {referred}: match {row['match']} of {row['name']} has no such program object "
                 f"(it has {', '.join(objects) or 'none'})"
             )
-        name = referred
-    else:
-        others = [n for n in objects if n != "ego"]
-        if len(others) != 1:
-            raise UserError(
-                f"the query's objects besides ego are {', '.join(others) or 'none'}: name the one the prompt refers "
-                "to with --referred NAME"
-            )
-        name = others[0]
-    found = objects[name]
-    return str(found["id"]), int(found["start_frame"]), int(found["end_frame"])
+        return referred
+    others = [n for n in objects if n != "ego"]
+    if len(others) != 1:
+        raise UserError(
+            f"the query's objects besides ego are {', '.join(others) or 'none'}: name the one the prompt refers "
+            "to with --referred NAME"
+        )
+    return others[0]
 
 
 def _objects_of_old_row(row: dict[str, Any]) -> dict[str, Any]:

@@ -217,8 +217,10 @@ class _Reader:
         if not isinstance(stamp, int) or isinstance(stamp, bool) or stamp < 0:
             raise self.fail(f"{where}.timestamp_ns", "must be a whole number of nanoseconds, not negative")
         label = frame.get("label", [])
-        if not isinstance(label, list) or not all(isinstance(v, int) and not isinstance(v, bool) for v in label):
-            raise self.fail(f"{where}.label", "must be a list of whole numbers")
+        if not isinstance(label, list) or not all(
+            isinstance(v, int) and not isinstance(v, bool) and -(2**63) <= v < 2**63 for v in label
+        ):
+            raise self.fail(f"{where}.label", "must be a list of whole numbers (64-bit)")
         n = len(label)
         ego = frame.get("ego_translation_m")
         ego_m = self.numbers(ego, 3, f"{where}.ego_translation_m") if ego is not None or n else np.full(3, np.nan)

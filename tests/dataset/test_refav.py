@@ -11,7 +11,7 @@ import pickle
 import numpy as np
 import pytest
 import shapely
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from scenegrep.cli.main import main
@@ -498,3 +498,44 @@ def test_a_row_written_before_the_objects_column_involves_its_objects_in_the_who
     old = results_of([match_row({"ego": "ego", "car": "c"}, 104, 111) | {"objects": None}])
     frames = refav_sequences(old, lambda _: av2_like(), "p")[("log-1", "p")]
     assert [f.track_id.tolist() for f in frames] == [[], ["c"], ["c"]]
+
+
+coordinate = st.floats(-80, 80, allow_nan=False)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(
+        st.tuples(coordinate, coordinate, st.floats(-4, 4), st.floats(0.5, 6), st.floats(0.5, 3)),
+        min_size=1,
+        max_size=8,
+    )
+)
+def test_box_filters_equal_a_brute_force_reference(boxes):
+    """Kept: centre within 50 m of the ego at (0, 0), and some corner within 5 m of the square
+    [0, 20] x [0, 20] (the distance to a rectangle written out)."""
+    n = len(boxes)
+    given_frame = RefFrame(
+        0,
+        np.zeros(3),
+        np.array([[x, y, 0.0] for x, y, *_ in boxes]),
+        np.array([[length, width, 1.0] for *_, length, width in boxes]),
+        np.array([yaw for _, _, yaw, _, _ in boxes]),
+        np.zeros(n, dtype=np.int64),
+        np.array([str(k) for k in range(n)]),
+        np.array(["CAR"] * n),
+    )
+    kept = filter_boxes(given_frame, 50.0, shapely.box(0, 0, 20, 20)).track_id.tolist()
+    expected = []
+    for k, (x, y, yaw, length, width) in enumerate(boxes):
+        near_corner = False
+        for along, across in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+            cx = x + along * length / 2 * math.cos(yaw) - across * width / 2 * math.sin(yaw)
+            cy = y + along * length / 2 * math.sin(yaw) + across * width / 2 * math.cos(yaw)
+            gap = math.hypot(max(0.0, -cx, cx - 20), max(0.0, -cy, cy - 20))
+            assume(abs(gap - 5.0) > 1e-6)  # rounding decides exactly at the line
+            near_corner |= gap <= 5.0
+        assume(abs(math.hypot(x, y) - 50.0) > 1e-6)
+        if math.hypot(x, y) <= 50.0 and near_corner:
+            expected.append(str(k))
+    assert kept == expected

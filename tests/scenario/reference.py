@@ -70,8 +70,13 @@ def _runs(query, obs, sets, assignment, start, m):
                 o.config
                 for c in current[name]
                 for o in hfsm.step(c, inputs)
-                if query.vocabulary.primitive(o.label).labels & observed
+                if state >= 0 and admits(query.vocabulary.primitive(o.label), observed)
             }
             if not current[name]:
                 return False
     return True
+
+
+def admits(primitive, observed: frozenset[str]) -> bool:
+    """Whether an observed label set admits a primitive (an "any" primitive admits every set)."""
+    return primitive.admits_any or bool(primitive.labels & observed)

@@ -2,7 +2,8 @@
 
 ``state_at[f, k]`` is the state row of label object k in frame f (-1 when absent);
 ``accept`` gives, per HFSM output alphabet, a bit mask per frame and object of the
-outputs the observed behaviour label set admits (through the vocabulary);
+outputs the observed behaviour label set admits (through the vocabulary; a primitive that
+admits any label set, such as ``AnyBehavior``, is admitted wherever the object is observed);
 :meth:`Observations.guard_codes` evaluates a guard for many assignments of label
 objects at once, with the scene query's decision procedure: a guard *can be true*
 when some value of its random variables satisfies it, *can be false* when some
@@ -76,8 +77,11 @@ class Observations:
             column = {name: k for k, name in enumerate(behaviours.vocabulary)}
             per_row = np.zeros(len(self.trace.states), dtype=np.int64)
             for p, name in enumerate(outputs):
-                cols = [column[label] for label in self.vocabulary.primitive(name).labels if label in column]
-                if cols:
+                primitive = self.vocabulary.primitive(name)
+                cols = [column[label] for label in primitive.labels if label in column]
+                if primitive.admits_any:
+                    per_row |= np.int64(1) << p
+                elif cols:
                     per_row |= behaviours.member[:, cols].any(axis=1).astype(np.int64) << p
             found = np.where(self.state_at >= 0, per_row[np.maximum(self.state_at, 0)], 0)
             self._accept[outputs] = found

@@ -5,6 +5,12 @@ A behaviour the program does not define (Scenic's library behaviours such as
 without the ``Behavior`` suffix. Datasets name behaviours their own way (``LC``,
 ``lane_change``, ``LaneChangeLeft``), so the vocabulary maps each primitive to the set
 of labels that count as it, and says whether it can end by itself.
+
+Scenic's rule stays the default: an object without a behaviour (or whose behaviour has ended)
+stands still, so it outputs :data:`STATIONARY` and its label set must hold ``Stationary``. A
+primitive marked ``any`` (the shipped one is ``AnyBehavior``, primitive name :data:`ANY`)
+admits every label set, also an empty one: it is how a query says an object's behaviour does
+not matter.
 """
 
 from __future__ import annotations
@@ -19,6 +25,8 @@ from ..errors import UserError, at
 DEFAULT_VOCABULARY = Path(__file__).with_name("vocabulary.toml")
 STATIONARY = "Stationary"
 """The output of an object without a behaviour (and of one whose behaviour has ended)."""
+ANY = "Any"
+"""The primitive name of the shipped "any behaviour" primitive (``do AnyBehavior()``)."""
 
 
 def primitive_name(behaviour: str) -> str:
@@ -28,11 +36,13 @@ def primitive_name(behaviour: str) -> str:
 
 @dataclass(frozen=True)
 class Primitive:
-    """A primitive behaviour: its name, the labels standing for it, and whether it can end by itself."""
+    """A primitive behaviour: its name, the labels standing for it, whether it can end by itself,
+    and whether it admits every label set (``admits_any``: then ``labels`` is just its name)."""
 
     name: str
     labels: frozenset[str]
     ends: bool
+    admits_any: bool = False
 
 
 @dataclass(frozen=True)
@@ -51,15 +61,17 @@ class Vocabulary:
 
 
 def _entry(name: str, value: Any, source: str) -> Primitive:
-    if not isinstance(value, dict) or set(value) - {"labels", "ends"}:
-        raise UserError(f"[{name}] must have only the keys 'labels' and 'ends'", at(source))
+    if not isinstance(value, dict) or set(value) - {"labels", "ends", "any"}:
+        raise UserError(f"[{name}] must have only the keys 'labels', 'ends' and 'any'", at(source))
     labels = value.get("labels", [])
     if not isinstance(labels, list) or not all(isinstance(label, str) for label in labels):
         raise UserError(f"[{name}] labels must be a list of strings", at(source))
-    ends = value.get("ends", True)
-    if not isinstance(ends, bool):
-        raise UserError(f"[{name}] ends must be true or false", at(source))
-    return Primitive(name, frozenset(labels) | {name}, ends)
+    ends, admits_any = value.get("ends", True), value.get("any", False)
+    if not isinstance(ends, bool) or not isinstance(admits_any, bool):
+        raise UserError(f"[{name}] {'ends' if not isinstance(ends, bool) else 'any'} must be true or false", at(source))
+    if admits_any and labels:
+        raise UserError(f"[{name}] admits any label (any = true), so it takes no labels", at(source))
+    return Primitive(name, frozenset(labels) | {name}, ends, admits_any)
 
 
 def read_vocabulary(path: str | Path) -> Vocabulary:

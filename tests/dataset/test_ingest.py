@@ -14,7 +14,7 @@ import pytest
 from scenegrep import readers
 from scenegrep.dataset.catalog import Catalog
 from scenegrep.dataset.ingest import COMMIT_EVERY, discover, ingest
-from scenegrep.label import label_trace
+from scenegrep.label import LABELLER_VERSION, label_trace
 
 from ..readers.real_inputs import REAL_TRACES
 from .conftest import SAMPLE, SAMPLE_TRACES
@@ -97,6 +97,21 @@ def test_a_changed_source_replaces_its_traces(real_data: Path, tmp_path: Path):
     assert second["traces"] == first["traces"]
     assert second["sources"][0][2] != first["sources"][0][2]
     assert sorted(p.name for p in (root / "traces").iterdir()) == [Path(first["traces"][0][3]).name]
+
+
+def test_a_newer_labeller_labels_an_ingested_source_again(real_data: Path, tmp_path: Path, monkeypatch):
+    source = tmp_path / "scene.xml"
+    shutil.copy(real_data / "commonroad_ngsim/USA_Peach-4_8_T-1.xml", source)
+    root = tmp_path / "ds"
+    assert ingest([str(source)], root, jobs=1).ingested == 1
+    assert ingest([str(source)], root, jobs=1).unchanged == 1
+    monkeypatch.setattr("scenegrep.label.LABELLER_VERSION", LABELLER_VERSION + 1)
+    report = ingest([str(source)], root, jobs=1)
+    assert (report.ingested, report.unchanged) == (1, 0)
+    assert catalog_state(root)["sources"][0][2].endswith(f"labeller {LABELLER_VERSION + 1}")
+    # without labelling, the labeller's version does not matter
+    assert ingest([str(source)], tmp_path / "plain", jobs=1, label=False).ingested == 1
+    assert ingest([str(source)], tmp_path / "plain", jobs=1, label=False).unchanged == 1
 
 
 def test_bad_sources_are_reported_and_the_rest_ingested(real_data: Path, tmp_path: Path):

@@ -5,7 +5,8 @@ Parquet traces), ``maps/<map_id>.parquet`` (their road maps, converted once per 
 ``runs/`` (query runs). Sources are files or directories the readers recognise; a directory
 that is not itself an input is searched for inputs, in name order.
 
-Ingest is incremental (a source whose SHA-256 is in the catalog is skipped), atomic per
+Ingest is incremental (a source whose SHA-256 is in the catalog is skipped, unless its traces
+were labelled by an older version of the labeller, :data:`~scenegrep.label.LABELLER_VERSION`), atomic per
 trace (each Parquet file appears whole, by rename, before the catalog commits the trace;
 a source's traces are committed together) and reports bad sources without stopping.
 Traces without behaviour labels are labelled with ``scenegrep label``'s labeller unless
@@ -157,6 +158,15 @@ def checksum(path: str) -> str:
     return digest.hexdigest()
 
 
+def source_key(path: str, label: bool) -> str:
+    """What the catalog keeps to tell an unchanged source: its :func:`checksum` and, when ingest
+    labels its traces, the labeller's version (labels of an older labeller are not reused)."""
+    from ..label import LABELLER_VERSION
+
+    digest = checksum(path)
+    return f"{digest} labeller {LABELLER_VERSION}" if label else digest
+
+
 def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)[:64] or "trace"
 
@@ -177,7 +187,7 @@ def ingest_source(task: IngestTask) -> SourceOutcome:
     maps and compute their statistics. Any failure becomes a 'failed' outcome."""
     source = task.source
     try:
-        digest = checksum(source.path)
+        digest = source_key(source.path, task.label)
         if digest == task.known_checksum:
             return SourceOutcome(source, "unchanged", digest)
         outcome = SourceOutcome(source, "ingested", digest, replaces=task.known_checksum is not None)

@@ -6,7 +6,16 @@ Pipeline: :mod:`.tracks` (segments, windows) → :mod:`.evidence` (kinematics an
 """
 
 from .config import DEFAULT_CONFIG, LabelConfig, load_config
-from .labeller import Labelling, label_trace
+from .labeller import LABELLER_VERSION, Labelling, label_trace
 from .rules import SCENIC_LABELS, VOCABULARY
 
-__all__ = ["DEFAULT_CONFIG", "SCENIC_LABELS", "VOCABULARY", "LabelConfig", "Labelling", "label_trace", "load_config"]
+__all__ = [
+    "DEFAULT_CONFIG",
+    "LABELLER_VERSION",
+    "SCENIC_LABELS",
+    "VOCABULARY",
+    "LabelConfig",
+    "Labelling",
+    "label_trace",
+    "load_config",
+]

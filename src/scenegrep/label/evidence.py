@@ -9,10 +9,13 @@ trace's own where given, else finite differences of positions.
 
 Map relations (all absent, i.e. -1/NaN/False, without a map): ``lane`` (index of the map lane
 the object is in, the best-aligned where lanes overlap), ``lane_heading`` (that lane's direction
-at the point), ``lateral`` (smoothed speed across the lane's direction, left positive),
-``in_intersection``, ``on_drivable``, ``in_crossing`` (1.0 or 0.0; NaN, unknown, on a map whose
-format does not publish crosswalks), and lane-id changes to a same-direction neighbour
-(``change_left`` / ``change_right``, set at the first observation in the new lane);
+at the point), ``lateral`` (smoothed speed across the lane, m/s, positive towards the object's
+left), ``in_intersection``, ``on_drivable``, ``in_crossing`` (1.0 or 0.0; NaN, unknown, on a map
+whose format does not publish crosswalks), lane-id changes to a same-direction neighbour on the
+object's left or right (``change_left`` / ``change_right``, set at the first observation in the
+new lane) and whether the lane has a same-direction neighbour on that side (``has_left`` /
+``has_right``). Sides are the object's own: those of the lane's direction when the object faces
+along its lane, swapped when it faces against it (a car on the opposing lane, overtaking);
 ``knows_intersections`` says whether the map has any intersection; ``map_name`` names the map.
 """
 
@@ -65,9 +68,13 @@ def gather(trace: LabelTrace, road_map: RoadMap | None, tracks: Tracks, smooth_s
     along = -np.sin(heading) * vx + np.cos(heading) * vy
     accel = tracks.window_mean(tracks.gradient(speed), half)
     relations = _MapRelations.of(road_map, x, y, heading)
-    lateral = -np.cos(relations.lane_heading) * vx - np.sin(relations.lane_heading) * vy
+    against = np.cos(heading - relations.lane_heading) < 0
+    lane_left = -np.cos(relations.lane_heading) * vx - np.sin(relations.lane_heading) * vy
     lane = tracks.forward_fill(relations.lane)
     previous = tracks.change_from(lane)
+    to_left, to_right = relations.is_left_change(previous, lane), relations.is_left_change(lane, previous)
+    has_left = relations.neighbour(relations.left, relations.lane) >= 0
+    has_right = relations.neighbour(relations.right, relations.lane) >= 0
     return Evidence(
         speed=speed,
         along=along,
@@ -77,14 +84,14 @@ def gather(trace: LabelTrace, road_map: RoadMap | None, tracks: Tracks, smooth_s
         motion_heading=heading_of_vector(vx, vy),
         lane=relations.lane,
         lane_heading=relations.lane_heading,
-        lateral=lateral,
+        lateral=np.where(against, -lane_left, lane_left),
         in_intersection=relations.in_intersection,
         on_drivable=relations.on_drivable,
         in_crossing=relations.in_crossing,
-        change_left=relations.is_left_change(previous, lane),
-        change_right=relations.is_left_change(lane, previous),
-        has_left=relations.neighbour(relations.left, relations.lane) >= 0,
-        has_right=relations.neighbour(relations.right, relations.lane) >= 0,
+        change_left=np.where(against, to_right, to_left),
+        change_right=np.where(against, to_left, to_right),
+        has_left=np.where(against, has_right, has_left),
+        has_right=np.where(against, has_left, has_right),
         knows_intersections=road_map is not None
         and bool(road_map.intersections or road_map.lane_is_intersection.any()),
         map_name=None if road_map is None else road_map.name,

@@ -21,6 +21,11 @@ from .evidence import Evidence, gather
 from .rules import VOCABULARY, confidences
 from .tracks import Tracks
 
+LABELLER_VERSION = 2
+"""Bumped whenever the labels of some input change, so that labels of an older labeller are not
+reused (an ingested dataset labels its sources again). 2: lane-change sides are the vehicle's own
+(swapped where it faces against its lane)."""
+
 
 @dataclass(frozen=True)
 class Labelling:

@@ -3,14 +3,16 @@
 Every confidence is a product of ramps (:data:`~.config.Ramp`) over the evidence, in [0, 1]:
 
 * vehicles (cars, trucks, buses, trailers, motorcycles): ``Stationary`` by the speed; moving is
-  its complement. ``LaneChangeLeft``/``Right`` by the speed across the lane (or a lane-id change
-  to the same-direction neighbour within ``lane_change_event_s``, with some lateral speed), while
+  its complement. ``LaneChangeLeft``/``Right`` by the speed across the lane towards the vehicle's
+  left or right (or a lane-id change to the same-direction neighbour on that side within
+  ``lane_change_event_s``, with some lateral speed; sides as in :mod:`.evidence`), while
   moving and outside intersections, reduced where that side has no same-direction lane; the speed
   across must also be sustained on average over ``lane_change_event_s`` either side (noise is not)
   and, unless the lane id changes nearby, the path nearly straight (curves read as lateral motion).
   ``FollowLane`` while moving, aligned with the lane, not changing lanes and not reversing.
   ``TurnLeft``/``Right`` by the heading change over ``turn_window_s`` near an intersection (anywhere
-  on a map without intersections). ``Brake`` and
+  on a map without intersections): counter-clockwise (the heading grows) is left, clockwise right,
+  so the two never hold together and a turn in Scenic's sense is exactly one of them. ``Brake`` and
   ``Accelerate`` by the longitudinal acceleration while moving; ``Reverse`` by the speed along
   the object's own heading.
 * pedestrians, cyclists and animals: ``Stationary`` by the speed, ``Walk`` its complement,

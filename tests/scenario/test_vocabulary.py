@@ -55,6 +55,22 @@ def test_vehicle_primitives_consume_the_frames_labelled_so(primitive, spelling):
             assert "car2" not in matched_ids(program, worked_trace([other] * 5), worked_map(), 5), other
 
 
+@pytest.mark.parametrize("primitive", VEHICLE_PRIMITIVES)
+def test_the_labellers_names_never_end_by_themselves(primitive):
+    # a primitive that can end may end before its first step, and an object that stands still
+    # would then match it; the labeller's names last until a `for`, `until` or interrupt ends them
+    assert not load_vocabulary().primitive(primitive).ends
+    program = ego_program(primitive, "do")
+    assert "car1" not in matched_ids(program, worked_trace([primitive] * 5), worked_map(), 5)
+    assert "car1" in matched_ids(ego_program("Turn", "do"), worked_trace([primitive] * 5), worked_map(), 5)
+    bounded = HEADER + (
+        f"behavior B():\n    do {primitive}Behavior() for 2 steps\n    do FollowLaneBehavior()\n"
+        "ego = new Car with behavior B()\n"
+    )
+    assert "car2" in matched_ids(bounded, worked_trace([primitive] * 2 + ["FollowLane"] * 3), worked_map(), 5)
+    assert "car2" not in matched_ids(bounded, worked_trace([primitive] + ["FollowLane"] * 4), worked_map(), 5)
+
+
 def pedestrian_trace(labels: list[set[str]]) -> LabelTrace:
     """One pedestrian walking east through the synthetic map's crosswalk, one label set per frame."""
     n = len(labels)

@@ -42,7 +42,9 @@ def vehicle_tracks(draw, northbound: bool = False):
     start = draw(st.integers(0, 20))
     x, y = draw(st.floats(0.5, 6.5)), draw(st.floats(20.0, 70.0))
     heading = draw(st.floats(-0.3, 0.3)) if northbound else draw(st.floats(-math.pi, math.pi))
-    pieces = draw(st.lists(st.tuples(st.floats(0.0, 15.0), st.floats(-0.8, 0.8), st.floats(-1.5, 1.5)), min_size=1, max_size=4))
+    pieces = draw(
+        st.lists(st.tuples(st.floats(0.0, 15.0), st.floats(-0.8, 0.8), st.floats(-1.5, 1.5)), min_size=1, max_size=4)
+    )
     xs, ys, hs = [], [], []
     for k in range(n):
         speed, yaw_rate, lateral = pieces[k * len(pieces) // n]
@@ -87,7 +89,11 @@ def segments(trace: LabelTrace) -> list[list[int]]:
         rows = sorted(np.flatnonzero(trace.states.object == obj).tolist(), key=lambda r: trace.states.frame[r])
         current: list[int] = []
         for row in rows:
-            if current and trace.frame_time[trace.states.frame[row]] - trace.frame_time[trace.states.frame[current[-1]]] > CONFIG.tracks.max_gap_s:
+            if (
+                current
+                and trace.frame_time[trace.states.frame[row]] - trace.frame_time[trace.states.frame[current[-1]]]
+                > CONFIG.tracks.max_gap_s
+            ):
                 found.append(current)
                 current = []
             current.append(row)
@@ -195,7 +201,9 @@ def test_turn_sides_are_the_signed_halves_of_one_heading_change(trace, with_map)
     unsided = np.array([ramp(abs(c), bounds) for c in change])
     halves = np.maximum([ramp(c, bounds) for c in change], [ramp(-c, bounds) for c in change])
     np.testing.assert_array_equal(unsided, halves)
-    np.testing.assert_array_equal(admitted(labelled, "Turn"), admitted(labelled, "TurnLeft") | admitted(labelled, "TurnRight"))
+    np.testing.assert_array_equal(
+        admitted(labelled, "Turn"), admitted(labelled, "TurnLeft") | admitted(labelled, "TurnRight")
+    )
 
 
 @settings(max_examples=150, deadline=None)

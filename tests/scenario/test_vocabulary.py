@@ -95,7 +95,9 @@ def test_pedestrian_primitives_consume_the_frames_labelled_so(primitive, other, 
     assert matched_ids(program, pedestrian_trace(mixed), synthetic_map(), 4, options) == set()
 
 
-@pytest.mark.parametrize(("whole", "sides"), [("Turn", ("TurnLeft", "TurnRight")), ("LaneChange", ("LaneChangeLeft", "LaneChangeRight"))])
+@pytest.mark.parametrize(
+    ("whole", "sides"), [("Turn", ("TurnLeft", "TurnRight")), ("LaneChange", ("LaneChangeLeft", "LaneChangeRight"))]
+)
 def test_a_side_is_one_half_of_the_unsided_primitive(whole, sides):
     left, right = sides
     for label in sides:

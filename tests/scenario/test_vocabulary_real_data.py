@@ -72,13 +72,17 @@ def ego_answers(relative: str, primitive: str, window: int) -> list[int]:
     """Starts of the windows in which the recording's ego runs ``primitive``."""
     trace = recording(relative)[0]
     assert trace.ego is not None
-    return answers(relative, f"ego = new Car with behavior {primitive}Behavior(), {FREE}\n", window, "ego").get(trace.ego, [])
+    return answers(relative, f"ego = new Car with behavior {primitive}Behavior(), {FREE}\n", window, "ego").get(
+        trace.ego, []
+    )
 
 
 def other_answers(relative: str, kind: str, primitive: str, window: int) -> dict[str, list[int]]:
     """Objects other than the ego running ``primitive``, whatever the ego does (AnyBehavior)."""
     free = f", {FREE}" if kind == "Car" else ""
-    program = f"ego = new Car with behavior AnyBehavior(), {FREE}\nx = new {kind} with behavior {primitive}Behavior(){free}\n"
+    program = (
+        f"ego = new Car with behavior AnyBehavior(), {FREE}\nx = new {kind} with behavior {primitive}Behavior(){free}\n"
+    )
     return answers(relative, program, window)
 
 
@@ -228,7 +232,10 @@ def test_walk_finds_walking_pedestrians_and_not_standing_ones():
         if not str(trace.objects.category[k]).startswith("human.pedestrian") or len(f) < window:
             continue
         v = speeds(t, x, y)
-        if any((v[i : i + window] > 0.8).all() and f[i + window - 1] - f[i] == window - 1 for i in range(len(f) - window + 1)):
+        if any(
+            (v[i : i + window] > 0.8).all() and f[i + window - 1] - f[i] == window - 1
+            for i in range(len(f) - window + 1)
+        ):
             walking.add(str(object_id))
         if v.max() < 0.2:
             standing.add(str(object_id))

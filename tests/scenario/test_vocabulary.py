@@ -18,7 +18,7 @@ from scenegrep.errors import UserError
 from scenegrep.model import BehaviourLabels, LabelTrace, ObjectTable, StateTable
 from scenegrep.model.layers import UnknownLayers
 from scenegrep.scenario import ScenarioOptions, compile_scenario, load_scenario
-from scenegrep.scenario.vocabulary import ANY, load_vocabulary, read_vocabulary
+from scenegrep.scenario.vocabulary import load_vocabulary, read_vocabulary
 from tests.model.maps import synthetic_map
 
 from .reference import reference_matches
@@ -173,7 +173,7 @@ def test_any_behaviour_is_not_a_scenic_name():
     package = Path(spec.origin).parent
     for path in [*package.rglob("*.scenic"), *package.rglob("*.py")]:
         assert "AnyBehavior" not in path.read_text(encoding="utf-8", errors="replace"), path
-    assert load_vocabulary().primitive(ANY).admits_any
+    assert load_vocabulary().primitive("Any").admits_any
 
 
 @pytest.mark.parametrize(

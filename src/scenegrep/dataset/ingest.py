@@ -6,8 +6,8 @@ Parquet traces), ``maps/<map_id>.parquet`` (their road maps, converted once per 
 that is not itself an input is searched for inputs, in name order.
 
 Ingest is incremental (a source whose SHA-256 is in the catalog is skipped, unless its traces
-were labelled by an older version of the labeller, :data:`~scenegrep.label.LABELLER_VERSION`), atomic per
-trace (each Parquet file appears whole, by rename, before the catalog commits the trace;
+were labelled by another version of the labeller, :data:`~scenegrep.label.LABELLER_VERSION`),
+atomic per trace (each Parquet file appears whole, by rename, before the catalog commits the trace;
 a source's traces are committed together) and reports bad sources without stopping.
 Traces without behaviour labels are labelled with ``scenegrep label``'s labeller unless
 ``label`` is False, so scenario queries need no labelling later.

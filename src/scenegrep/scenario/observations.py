@@ -78,10 +78,11 @@ class Observations:
             per_row = np.zeros(len(self.trace.states), dtype=np.int64)
             for p, name in enumerate(outputs):
                 primitive = self.vocabulary.primitive(name)
-                cols = [column[label] for label in primitive.labels if label in column]
                 if primitive.admits_any:
                     per_row |= np.int64(1) << p
-                elif cols:
+                    continue
+                cols = [column[label] for label in primitive.labels if label in column]
+                if cols:
                     per_row |= behaviours.member[:, cols].any(axis=1).astype(np.int64) << p
             found = np.where(self.state_at >= 0, per_row[np.maximum(self.state_at, 0)], 0)
             self._accept[outputs] = found

@@ -8,7 +8,7 @@ of labels that count as it, and says whether it can end by itself.
 
 Scenic's rule stays the default: an object without a behaviour (or whose behaviour has ended)
 stands still, so it outputs :data:`STATIONARY` and its label set must hold ``Stationary``. A
-primitive marked ``any`` (the shipped one is ``AnyBehavior``, primitive name :data:`ANY`)
+primitive marked ``any`` (the shipped one is ``AnyBehavior``, primitive name ``Any``)
 admits every label set, also an empty one: it is how a query says an object's behaviour does
 not matter.
 """
@@ -25,8 +25,6 @@ from ..errors import UserError, at
 DEFAULT_VOCABULARY = Path(__file__).with_name("vocabulary.toml")
 STATIONARY = "Stationary"
 """The output of an object without a behaviour (and of one whose behaviour has ended)."""
-ANY = "Any"
-"""The primitive name of the shipped "any behaviour" primitive (``do AnyBehavior()``)."""
 
 
 def primitive_name(behaviour: str) -> str:
@@ -67,8 +65,9 @@ def _entry(name: str, value: Any, source: str) -> Primitive:
     if not isinstance(labels, list) or not all(isinstance(label, str) for label in labels):
         raise UserError(f"[{name}] labels must be a list of strings", at(source))
     ends, admits_any = value.get("ends", True), value.get("any", False)
-    if not isinstance(ends, bool) or not isinstance(admits_any, bool):
-        raise UserError(f"[{name}] {'ends' if not isinstance(ends, bool) else 'any'} must be true or false", at(source))
+    for key, flag in (("ends", ends), ("any", admits_any)):
+        if not isinstance(flag, bool):
+            raise UserError(f"[{name}] {key} must be true or false", at(source))
     if admits_any and labels:
         raise UserError(f"[{name}] admits any label (any = true), so it takes no labels", at(source))
     return Primitive(name, frozenset(labels) | {name}, ends, admits_any)

@@ -116,7 +116,7 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     road_map = geometry._require_map()
     areas = list(road_map.lane_polygons) + [a.polygon for a in road_map.intersections]
     starts, ends = [np.zeros((0, 2))], [np.zeros((0, 2))]
-    for ring in shapely.get_rings(np.array(areas, dtype=object)):
+    for ring in shapely.get_rings(shapely.get_parts(np.array(areas, dtype=object))):
         coords = shapely.get_coordinates(ring)
         starts.append(coords[:-1])
         ends.append(coords[1:])

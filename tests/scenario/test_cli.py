@@ -79,10 +79,10 @@ def test_window_errors(files, capsys, args, message):
 
 def test_unsupported_construct_is_one_line_with_place(files, tmp_path, capsys):
     program = tmp_path / "bad.scenic"
-    program.write_text("behavior B():\n    do A() until self.height > 3\n\nego = new Car with behavior B()\n")
+    program.write_text("behavior B():\n    do Turn() until self.height > 3\n\nego = new Car with behavior B()\n")
     code, _, err = run([program, files / "table2.json", "--window", "5"], capsys)
     assert code == 2 and "Traceback" not in "\n".join(err)
-    assert err[0].startswith(f"scenegrep: error: {program}:2:18: ") and "height" in err[0]
+    assert err[0].startswith(f"scenegrep: error: {program}:2:21: ") and "height" in err[0]
 
 
 def test_online_reports_the_windows_of_the_offline_query(files, capsys, monkeypatch):

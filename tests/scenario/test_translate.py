@@ -62,11 +62,11 @@ def test_parameters_bind_arguments_and_self():
     ("behaviours", "call", "message", "line"),
     [
         ("behavior B():\n    do B()\n", "B()", "runs itself", 3),
-        ("behavior B(d):\n    do A() until (distance to other) < d\n", "B(Range(1, 2))", "is random", 4),
-        ("behavior B():\n    do A() for Range(1, 2) steps\n", "B()", "constant number", 3),
+        ("behavior B(d):\n    do Turn() until (distance to other) < d\n", "B(Range(1, 2))", "is random", 4),
+        ("behavior B():\n    do Turn() for Range(1, 2) steps\n", "B()", "constant number", 3),
         ("behavior B():\n    take SetBrakeAction(1)\n", "B()", "whole primitive behaviour", 3),
-        ("behavior B(x):\n    do A()\n", "B()", "needs a value for its parameter 'x'", 4),
-        ("behavior B():\n    do A() until self.height > 1\n", "B()", "no property 'height'", 3),
+        ("behavior B(x):\n    do Turn()\n", "B()", "needs a value for its parameter 'x'", 4),
+        ("behavior B():\n    do Turn() until self.height > 1\n", "B()", "no property 'height'", 3),
     ],
 )
 def test_errors_point_at_the_place(behaviours, call, message, line):

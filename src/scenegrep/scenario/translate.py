@@ -14,6 +14,7 @@ behaviour's arguments once per call and a guard must be memoryless).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from ..scenic import ir
@@ -77,7 +78,14 @@ class Translator:
         if definition is None:
             if call.function in bindings or call.function in self.resolver.scope:
                 raise self.error(f"{call.function!r} is not a behaviour", call)
-            primitive = self.vocabulary.primitive(primitive_name(call.function))
+            name = primitive_name(call.function)
+            if name not in self.vocabulary.entries:
+                raise self.error(
+                    f"unknown behaviour {call.function}: the program does not define it and the vocabulary"
+                    f" ({Path(self.vocabulary.source).name}) has no primitive {name!r}; add it to a --vocabulary file",
+                    call,
+                )
+            primitive = self.vocabulary.primitive(name)
             return H.BaseState(primitive.name, primitive.ends)
         if call.function in stack:
             raise self.error(f"behaviour {call.function} runs itself (recursion is not supported)", call)

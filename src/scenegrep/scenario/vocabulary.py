@@ -45,7 +45,9 @@ class Primitive:
 
 @dataclass(frozen=True)
 class Vocabulary:
-    """Primitive name -> :class:`Primitive`; unknown names stand for themselves and can end."""
+    """Primitive name -> :class:`Primitive`. A program may call only the primitives listed; a
+    primitive the program defines itself (a ``while True:`` body) and is not listed stands for its
+    own name and never ends (see :mod:`.translate`)."""
 
     entries: dict[str, Primitive]
     source: str = str(DEFAULT_VOCABULARY)

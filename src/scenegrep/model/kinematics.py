@@ -20,19 +20,19 @@ def track_order(states: StateTable) -> np.ndarray:
     return np.lexsort((states.frame, states.object))
 
 
-def finite_difference_velocity(
-    states: StateTable, frame_time: np.ndarray, max_gap_s: float = 1.0
-) -> tuple[np.ndarray, np.ndarray]:
-    """Velocity (vx, vy) in m/s of every state row from its track's neighbouring positions.
+def finite_difference(
+    states: StateTable, frame_time: np.ndarray, columns: tuple[np.ndarray, ...], max_gap_s: float = 1.0
+) -> tuple[np.ndarray, ...]:
+    """Time derivative (units of ``columns`` per second) of per-state-row values along each track.
 
     Central differences inside a track, one-sided at its ends; a neighbour more than
     ``max_gap_s`` seconds away (a gap in the track) is not used. Rows with no usable
-    neighbour get NaN.
+    neighbour get NaN, and so do rows whose difference reads a NaN value.
     """
     order = track_order(states)
     obj = states.object[order]
     t = frame_time[states.frame[order]]
-    xy = np.stack([states.x[order], states.y[order]], axis=1)
+    values = np.stack([column[order] for column in columns], axis=1)
     same_next = np.zeros(len(order), dtype=bool)
     same_next[:-1] = (obj[1:] == obj[:-1]) & (np.diff(t) <= max_gap_s) & (np.diff(t) > 0)
     same_prev = np.zeros(len(order), dtype=bool)
@@ -42,13 +42,28 @@ def finite_difference_velocity(
     prv = np.where(same_prev, np.maximum(idx - 1, 0), idx)
     dt = t[nxt] - t[prv]
     with np.errstate(invalid="ignore", divide="ignore"):
-        v = (xy[nxt] - xy[prv]) / dt[:, None]
-    v[dt <= 0] = np.nan
-    vx = np.empty(len(order))
-    vy = np.empty(len(order))
-    vx[order] = v[:, 0]
-    vy[order] = v[:, 1]
+        rate = (values[nxt] - values[prv]) / dt[:, None]
+    rate[dt <= 0] = np.nan
+    out = np.empty_like(rate)
+    out[order] = rate
+    return tuple(out[:, k] for k in range(len(columns)))
+
+
+def finite_difference_velocity(
+    states: StateTable, frame_time: np.ndarray, max_gap_s: float = 1.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Velocity (vx, vy) in m/s of every state row: :func:`finite_difference` of its positions."""
+    vx, vy = finite_difference(states, frame_time, (states.x, states.y), max_gap_s)
     return vx, vy
+
+
+def finite_difference_acceleration(
+    states: StateTable, frame_time: np.ndarray, max_gap_s: float = 1.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Acceleration (ax, ay) in m/s² of every state row, map frame: :func:`finite_difference` of its
+    velocities (NaN where a velocity it reads is NaN)."""
+    ax, ay = finite_difference(states, frame_time, (states.vx, states.vy), max_gap_s)
+    return ax, ay
 
 
 def with_derived_velocity(states: StateTable, frame_time: np.ndarray) -> StateTable:

@@ -93,6 +93,13 @@ CLASSES: dict[str, ClassSpec] = {
 DYNAMIC_PROPERTIES = ("speed", "velocity", "angularSpeed")
 """Scenic's dynamic properties a program may set ``with``: matched against the labels' velocities."""
 
+DERIVED_PROPERTIES = {
+    "acceleration": "acceleration is derived from the labeled velocities; compare it in a require",
+}
+"""scenegrep's extensions: properties Scenic 3.1.1 does not define, read from the labels (acceleration,
+a vector in m/s², map frame). Setting one ``with`` is an error, so no program Scenic accepts (where
+``with acceleration V`` is a user property) silently means something else here."""
+
 NO_EFFECT_PROPERTIES = ("color", "render", "showVisibleRegion")
 """Scenic properties that only change how Scenic draws a scene: accepted, as they shape nothing."""
 

@@ -14,14 +14,15 @@ the caller can accept a row when any copy is feasible.
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
 from ..errors import UserError, at
 from ..model import LabelTrace
 from ..model.geometry import heading_of_vector, normalize_angle
-from ..model.kinematics import ESTIMATED_VELOCITY
+from ..model.kinematics import ESTIMATED_VELOCITY, finite_difference_acceleration
 from .geometry import MapGeometry
 from .program import TRACE, ProgramObject
 from .regions import Region
@@ -32,9 +33,16 @@ class NotAffine(Exception):
     """A term is not linear in the unknowns (the caller falls back to a general solver)."""
 
 
-DYNAMIC_COLUMNS = {"vx": "vx", "vy": "vy", "speed": "speed", "angularSpeed": "angular_speed"}
-"""Dynamic features (m/s, rad/s) -> their :class:`Labels` column; NaN there means the trace lacks them."""
-_FEATURE_NAMES = {"vx": "velocity", "vy": "velocity"}
+DYNAMIC_COLUMNS = {
+    "vx": "vx",
+    "vy": "vy",
+    "speed": "speed",
+    "angularSpeed": "angular_speed",
+    "ax": "ax",
+    "ay": "ay",
+}
+"""Dynamic features (m/s, rad/s, m/s²) -> their :class:`Labels` column; NaN there means the trace lacks them."""
+_FEATURE_NAMES = {"vx": "velocity", "vy": "velocity", "ax": "acceleration", "ay": "acceleration"}
 """The Scenic property a feature is part of, for messages."""
 
 
@@ -43,7 +51,10 @@ class Labels:
     """Label state columns of one trace (indexed by state row) and its trace attributes.
 
     ``vx``, ``vy`` and ``speed`` are in m/s, ``angular_speed`` in rad/s; NaN where the data has no
-    value. ``trace`` (when known) names the places of unknown values in errors.
+    value. ``ax``, ``ay`` (m/s², map frame) are derived, never read: the finite differences of
+    ``vx``, ``vy`` along each track of ``trace``
+    (:func:`~scenegrep.model.kinematics.finite_difference_acceleration`), so unknown where the
+    velocities are. ``trace`` (when known) names the places of unknown values in errors.
     """
 
     x: np.ndarray
@@ -68,6 +79,23 @@ class Labels:
             raise self._unknown(obj, feature, int(states[unknown[0]]))
         return values
 
+    @cached_property
+    def _acceleration(self) -> tuple[np.ndarray, np.ndarray] | None:
+        if self.vx is None or self.vy is None or self.trace is None:
+            return None
+        states = replace(self.trace.states, vx=self.vx, vy=self.vy)
+        return finite_difference_acceleration(states, self.trace.frame_time)
+
+    @property
+    def ax(self) -> np.ndarray | None:
+        """Acceleration along x (m/s²) per state row; None when the trace has no velocities."""
+        return None if self._acceleration is None else self._acceleration[0]
+
+    @property
+    def ay(self) -> np.ndarray | None:
+        """Acceleration along y (m/s²) per state row; None when the trace has no velocities."""
+        return None if self._acceleration is None else self._acceleration[1]
+
     def _unknown(self, obj: str, feature: str, state: int) -> UserError:
         if self.trace is None:
             name = _FEATURE_NAMES.get(feature, feature)
@@ -81,6 +109,8 @@ class Labels:
         estimated = trace.attributes.get(ESTIMATED_VELOCITY)
         if estimated is not None and name != "angularSpeed":
             message += f" (the data records none; the reader's estimates from {estimated} are not labels)"
+        elif name == "acceleration":
+            message += " (accelerations are differences of labeled velocities of the track's neighbouring frames)"
         return UserError(message, where)
 
 

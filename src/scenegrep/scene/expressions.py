@@ -345,6 +345,19 @@ def _abs(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
     return r.f.op("abs", to_num(r, args[0], node.args[0]))
 
 
+def _relative_speed(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
+    """``RelativeSpeed(X[, Y])``, scenegrep's extension (Scenic 3.1.1 has no such operator):
+    |X.velocity - Y.velocity| in m/s, Y the ego when omitted, X and Y scene objects."""
+    _arity(r, node, args, 1, 2)
+    if len(args) == 1 and "ego" not in r.scope:
+        raise r.error("RelativeSpeed(X) refers to ego, which is not defined yet", node)
+    objects = [*args, r.scope["ego"]] if len(args) == 1 else args
+    for obj, arg in zip(objects, [*node.args, node]):
+        if not (isinstance(obj, Instance) and obj.is_object):
+            raise r.error(f"RelativeSpeed needs scene objects, got {type_name(obj)}", arg)
+    return V.norm(r.f, V.sub(r.f, objects[0].get("velocity"), objects[1].get("velocity")))
+
+
 def _local_path(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
     _arity(r, node, args, 1)
     if not (isinstance(args[0], Term) and args[0].kind == "str"):
@@ -364,6 +377,7 @@ _CALLS: dict[str, Callable[[Resolver, ir.Call, list[Any]], Any]] = {
     "max": _minmax,
     "abs": _abs,
     "localPath": _local_path,
+    "RelativeSpeed": _relative_speed,
 }
 
 

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 from ..scenic import ir
 from . import expressions as E
 from . import vectors as V
-from .domain import CLASSES, UNMODELLED_PROPERTIES, Default, default_expression, defaulted_properties
+from .domain import CLASSES, DERIVED_PROPERTIES, UNMODELLED_PROPERTIES, Default, default_expression, defaulted_properties
 from .program import HEADING_FEATURE, Feature, ProgramObject, Requirement
 from .regions import (
     Difference,
@@ -318,6 +318,8 @@ def _with(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     prop = node.property or ""
     if prop in UNMODELLED_PROPERTIES:
         raise r.error(f"the property {prop!r} is not supported: {UNMODELLED_PROPERTIES[prop]}", node)
+    if prop in DERIVED_PROPERTIES:
+        raise r.error(f"the property {prop!r} cannot be set: {DERIVED_PROPERTIES[prop]}", node)
     if prop == "heading":
         return _facing(r, node, ops)
     if prop in ("position", "x", "y"):

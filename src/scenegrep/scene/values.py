@@ -79,7 +79,8 @@ class Instance:
 
 def observed_view(factory: TermFactory, name: str) -> dict[str, Any]:
     """The observed leaves of scene object ``name``: position, heading, orientation, width, length,
-    and the dynamic properties speed (m/s), velocity (m/s, map frame) and angularSpeed (rad/s)."""
+    the dynamic properties speed (m/s), velocity (m/s, map frame) and angularSpeed (rad/s), and
+    scenegrep's extension acceleration (m/s², map frame; see :data:`.domain.DERIVED_PROPERTIES`)."""
     heading = factory.observed(name, "heading")
     return {
         "position": Vec(factory.observed(name, "x"), factory.observed(name, "y")),
@@ -90,6 +91,7 @@ def observed_view(factory: TermFactory, name: str) -> dict[str, Any]:
         "speed": factory.observed(name, "speed"),
         "velocity": Vec(factory.observed(name, "vx"), factory.observed(name, "vy")),
         "angularSpeed": factory.observed(name, "angularSpeed"),
+        "acceleration": Vec(factory.observed(name, "ax"), factory.observed(name, "ay")),
     }
 
 

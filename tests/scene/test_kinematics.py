@@ -9,23 +9,30 @@ frames, ``RelativeSpeed(X, Y)`` equals |vX - vY| and ``apparent heading of X fro
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import textwrap
 from functools import cache
+from pathlib import Path
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scenic.core.geometry import apparentHeadingAtPoint
 
 from scenegrep.errors import UserError
-from scenegrep.model import LabelTrace, ObjectTable, StateTable
+from scenegrep.model import BehaviourLabels, LabelTrace, ObjectTable, StateTable
 from scenegrep.model.kinematics import finite_difference_velocity
-from scenegrep.scene import compile_scene
+from scenegrep.model.layers import UnknownLayers
+from scenegrep.scenario import ScenarioOptions, compile_scenario
+from scenegrep.readers.av2_forecasting import read_trace
+from scenegrep.scene import SceneOptions, compile_scene
 from scenegrep.scene.evaluate import Evaluator, Rows
 from scenegrep.scene.geometry import geometry_of
 from scenegrep.scene.match import labels_of
-from tests.scene.frames import HEADER
+from tests.scene.frames import HEADER, MAP, matches, trace_of
 
 MAX_GAP_S = 1.0
 """Neighbouring states of a track farther apart than this (s) are not differenced (the engine's rule)."""
@@ -179,3 +186,170 @@ def test_relative_speed_and_apparent_heading_equal_scenic_definitions(frames):
     assert np.max(angle_gap(apparent, scenic)) < 1e-12
     for name in ("apparent heading of c", "apparent heading of c from ego"):
         assert np.max(angle_gap(evaluate(program, name, trace, rows), apparent)) < 1e-9
+
+
+# ---------------------------------------------------------------------------- scene queries
+def moving(x: float, y: float, vy: float, vx: float = 0.0) -> tuple:
+    """A northbound 4.5 x 2 m car at (x, y) with velocity (vx, vy) m/s."""
+    return ("Car", x, y, 0.0, 4.5, 2.0, vx, vy)
+
+
+# the ego drives at 10 m/s; c, 10 m ahead, brakes from 10 to 4 m/s (frames 1 s apart)
+BRAKING = [{"ego": moving(1.75, 20, 10), "c": moving(1.75, 34.5, vy)} for vy in (10.0, 10.0, 7.0, 4.0, 4.0)]
+
+
+@pytest.mark.parametrize(
+    ("program", "expected"),
+    [
+        # c's acceleration by differences of its velocities: 0, -1.5, -3, -1.5, 0 m/s²
+        ("c = new Car ahead of ego by 10\nrequire c.acceleration.y < -1\n", [False, True, True, True, False]),
+        ("c = new Car ahead of ego by 10\nrequire c.acceleration.y < -2\n", [False, False, True, False, False]),
+        ("c = new Car ahead of ego by 10\nrequire abs(ego.acceleration.y) > 0\n", [False] * 5),
+        # |vc - vego| = 0, 0, 3, 6, 6 m/s
+        ("c = new Car ahead of ego by 10\nrequire RelativeSpeed(c) > 2\n", [False, False, True, True, True]),
+        ("c = new Car ahead of ego by 10\nrequire RelativeSpeed(ego, c) > 4\n", [False, False, False, True, True]),
+        ("c = new Car ahead of ego by 10, with speed Range(3, 8)\n", [False, False, True, True, True]),
+        ("c = new Car\nrequire abs(apparent heading of c from ego) < 1 deg\n", [True] * 5),
+    ],
+)
+def test_kinematics_in_scene_requirements_and_specifiers(program, expected):
+    assert matches("ego = new Car\n" + program, *BRAKING) == expected
+
+
+def test_apparent_heading_of_a_car_in_the_next_lane():
+    """c in the next lane 10 m ahead, both facing north: seen from the ego at a bearing of
+    -atan(3.5 / 10.5) (to the right), so c's apparent heading is +0.3217 rad (18.4 deg)."""
+    frame = {"ego": moving(1.75, 20, 10), "c": moving(5.25, 30.5, 10)}
+    program = "ego = new Car\nc = new Car\nrequire {} < apparent heading of c from ego < {}\n"
+    assert math.atan2(3.5, 10.5) == pytest.approx(0.32175, abs=1e-5)
+    assert matches(program.format("18.4 deg", "18.5 deg"), frame) == [True]
+    assert matches(program.format("-18.5 deg", "-18.4 deg"), frame) == [False]
+
+
+@pytest.mark.parametrize(
+    ("frames", "message"),
+    [
+        ([{"ego": moving(1.75, 20, 10)}], "trace 'hand' has no acceleration for object 'ego' at frame 0"),
+        ([{"ego": ("Car", 1.75, 20, 0.0)}] * 2, "trace 'hand' has no acceleration for object 'ego' at frame 0"),
+    ],
+)
+def test_an_unknown_acceleration_is_an_error_never_true(frames, message):
+    """One frame: no neighbour to difference; no velocities: nothing to difference."""
+    with pytest.raises(UserError) as caught:
+        matches("ego = new Car\nrequire ego.acceleration.y < 1\n", *frames)
+    line = caught.value.one_line()
+    reason = "accelerations are differences of labeled velocities of the track's neighbouring frames"
+    assert line == f"ego.acceleration is unknown: {message} ({reason})"
+
+
+@pytest.mark.parametrize(
+    ("program", "error"),
+    [
+        ("ego = new Car with acceleration (0, 1)\n", "2:15: the property 'acceleration' cannot be set"),
+        ("ego = new Car\nrequire RelativeSpeed(ego.position) > 1\n", "3:23: RelativeSpeed needs scene objects"),
+        ("c = new Car\nrequire RelativeSpeed(c) > 1\n", "3:9: RelativeSpeed(X) refers to ego, which is not defined"),
+        ("ego = new Car\nrequire RelativeSpeed(ego, ego, ego) > 1\n", "3:9: RelativeSpeed takes 1 or 2 arguments"),
+    ],
+)
+def test_kinematic_errors_are_one_line_at_their_place(program, error):
+    for compile_query in (compile_scene, compile_scenario):
+        with pytest.raises(UserError) as caught:
+            compile_query(HEADER + program, "k.scenic")
+        assert caught.value.one_line().startswith(f"k.scenic:{error}")
+
+
+# ---------------------------------------------------------------------------- scenario guards
+OVERTAKEN = [  # the ego at 10 m/s; c 10.5 m ahead speeds up, slows down, moves to the next lane at frame 6
+    {"ego": moving(1.75, 20 + 10 * t, 10), "c": moving(1.75 if t < 6 else 5.25, 30.5 + 10 * t, vy)}
+    for t, vy in enumerate((10.0, 10.0, 10.0, 14.0, 14.0, 10.0, 10.0, 10.0))
+]
+
+
+@pytest.mark.parametrize(
+    ("guard", "expected"),
+    [
+        ("ego.speed > 5", []),  # always true: Drive ends at once, and no frame is labeled Stop
+        ("ego.speed < 5", [0, 1, 2, 3, 4, 5]),  # never true
+        ("RelativeSpeed(otherCar) > 2", [0, 5]),  # true at frames 3, 4 (4 m/s)
+        ("otherCar.acceleration.y > 1", [4, 5]),  # central differences 0, 0, 2, 2, -2, -2, 0, 0 m/s²
+        ("abs(apparent heading of otherCar from ego) > 10 deg", [0, 1, 2, 3]),  # 0, then 0.3217 rad from frame 6
+    ],
+)
+def test_kinematics_in_scenario_guards(guard, expected):
+    """Every state is labeled Drive, none Stop: a window of 3 frames matches where the guard that
+    would end Drive never holds in it."""
+    program = textwrap.dedent(f"""\
+        behavior Drive():
+            while True:
+                wait
+        behavior Stop():
+            while True:
+                wait
+        behavior Go():
+            do Drive() until {guard}
+            do Stop()
+        ego = new Car with behavior Go()
+        otherCar = new Car with behavior Drive()
+        """)
+    trace = trace_of(*OVERTAKEN)
+    labeled = dataclasses.replace(trace, behaviours=BehaviourLabels.from_sets([{"Drive"}] * len(trace.states)))
+    query = compile_scenario(HEADER + program, "guard.scenic")
+    options = ScenarioOptions(find_all=True, unknown_layers=UnknownLayers("permissive"))
+    result = query.match(labeled, 3, MAP, options)
+    found = [m.starts.tolist() for m in result.matches if m.correspondence == {"ego": "ego", "otherCar": "c"}]
+    assert found == ([expected] if expected else [])
+
+
+# ---------------------------------------------------------------------------- a real recording
+AV2 = Path(__file__).parents[2].parent / "shared/real_data/av2/forecasting/0a1e6f0a-1817-4a98-b02e-db8c9327d151"
+BRAKING_EGO = "ego = new Object in everywhere, facing Range(0, 360) deg\n"
+
+
+@pytest.fixture(scope="module")
+def recording():
+    """The AV2 trace and, by hand from its Parquet table, the ego's ('AV') and the focal track's
+    time (s, from the timestamps), velocity and acceleration (np.gradient of velocity_x/y: central
+    differences, one-sided at the ends) per timestep."""
+    if not AV2.exists():
+        pytest.skip("../shared/real_data is not here")
+    table = pq.read_table(AV2 / f"scenario_{AV2.name}.parquet").to_pandas()
+    tracks = {}
+    for name, track_id in (("ego", "AV"), ("focal", table.focal_track_id.iloc[0])):
+        rows = table[table.track_id == track_id].sort_values("timestep")
+        assert rows.timestep.tolist() == list(range(110))
+        step_s = (rows.end_timestamp.iloc[0] - rows.start_timestamp.iloc[0]) / (rows.num_timestamps.iloc[0] - 1) / 1e9
+        time = rows.timestep.to_numpy() * step_s
+        v = np.stack([rows.velocity_x.to_numpy(), rows.velocity_y.to_numpy()], axis=1)
+        tracks[name] = (time, v, np.stack([np.gradient(v[:, 0], time), np.gradient(v[:, 1], time)], axis=1))
+    trace = read_trace(AV2)
+    assert trace.attributes["focal_track_id"] == table.focal_track_id.iloc[0]
+    return trace, tracks
+
+
+def test_acceleration_on_a_real_recording(recording):
+    """The ego brakes harder than 1 m/s² (acceleration along its velocity) at timesteps 18-36."""
+    trace, tracks = recording
+    time, v, a = tracks["ego"]
+    assert np.diff(time) == pytest.approx(0.1)
+    along = (a * v).sum(axis=1) / np.hypot(v[:, 0], v[:, 1])
+    # by hand at timestep 28: v(27) = (0.2237, 3.3001), v(29) = (0.1532, 2.3050) m/s, 0.2 s apart
+    assert v[27] == pytest.approx([0.2237, 3.3001], abs=1e-4) and v[29] == pytest.approx([0.1532, 2.3050], abs=1e-4)
+    assert along[28] == pytest.approx(-4.99, abs=0.01)
+    assert np.flatnonzero(along < -1).tolist() == list(range(18, 37))
+    along_velocity = "ego.acceleration.x * ego.velocity.x + ego.acceleration.y * ego.velocity.y"
+    program = BRAKING_EGO + f"require {along_velocity} < -ego.speed\n"
+    query = compile_scene(HEADER + program, "braking.scenic")
+    assert query.match(trace, None, SceneOptions()).frames().tolist() == list(range(18, 37))
+
+
+def test_relative_speed_on_a_real_recording(recording):
+    """|v(focal track) - v(AV)| exceeds 2 m/s except at timesteps 16-19 and 46-57."""
+    trace, tracks = recording
+    relative = np.hypot(*(tracks["focal"][1] - tracks["ego"][1]).T)
+    expected = np.flatnonzero(relative > 2)
+    assert np.flatnonzero(relative <= 2).tolist() == [*range(16, 20), *range(46, 58)]
+    assert relative[16:20] == pytest.approx([1.87, 1.86, 1.80, 1.97], abs=0.01)
+    program = BRAKING_EGO + "c = new Object in everywhere, facing Range(0, 360) deg, with requireVisible False\n"
+    query = compile_scene(HEADER + program + "require RelativeSpeed(c) > 2\n", "relative.scenic")
+    options = SceneOptions(correspondence={"ego": "AV", "c": trace.attributes["focal_track_id"]})
+    assert query.match(trace, None, options).frames().tolist() == expected.tolist()

@@ -25,7 +25,14 @@ from typing import TYPE_CHECKING, Any
 from ..scenic import ir
 from . import expressions as E
 from . import vectors as V
-from .domain import CLASSES, DERIVED_PROPERTIES, UNMODELLED_PROPERTIES, Default, default_expression, defaulted_properties
+from .domain import (
+    CLASSES,
+    DERIVED_PROPERTIES,
+    UNMODELLED_PROPERTIES,
+    Default,
+    default_expression,
+    defaulted_properties,
+)
 from .program import HEADING_FEATURE, Feature, ProgramObject, Requirement
 from .regions import (
     Difference,

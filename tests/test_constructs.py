@@ -179,6 +179,9 @@ velocities either: their reader estimates them from positions (for SpRE and the 
 queries treat those estimates as unknown, not as labels. The other readers give the velocities
 the data records (AV2 forecasting, Waymo, ScenarioNet, CommonRoad, scenegrep's JSON and Parquet
 traces), or none.
+Two kinematic extensions read the same velocities: `acceleration` (the finite differences of
+the labeled velocities along each track; no data format records accelerations) and
+`RelativeSpeed(X, Y)` (Scenic 3.1.1 has no `relative speed` operator).
 
 Each row is tested by `tests/test_constructs.py`: modelled rows run a query that depends on
 the construct on hand-built frames and check the answer worked out by hand; rejected rows

@@ -28,6 +28,7 @@ from scenegrep.model.kinematics import finite_difference_velocity
 from scenegrep.model.layers import UnknownLayers
 from scenegrep.scenario import ScenarioOptions, compile_scenario
 from scenegrep.readers.av2_forecasting import read_trace
+from scenegrep.readers.av2_sensor import read_trace as read_sensor_log
 from scenegrep.scene import SceneOptions, compile_scene
 from scenegrep.scene.evaluate import Evaluator, Rows
 from scenegrep.scene.geometry import geometry_of
@@ -353,3 +354,17 @@ def test_relative_speed_on_a_real_recording(recording):
     query = compile_scene(HEADER + program + "require RelativeSpeed(c) > 2\n", "relative.scenic")
     options = SceneOptions(correspondence={"ego": "AV", "c": trace.attributes["focal_track_id"]})
     assert query.match(trace, None, options).frames().tolist() == expected.tolist()
+
+
+def test_accelerations_from_estimated_velocities_are_unknown():
+    """AV2 sensor logs record no velocities: the accelerations, their differences, are unknown too."""
+    log = AV2.parents[1] / "sensor" / "7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
+    if not log.exists():
+        pytest.skip("../shared/real_data is not here")
+    query = compile_scene(HEADER + BRAKING_EGO + "require ego.acceleration.y > 1\n", "accelerating.scenic")
+    with pytest.raises(UserError) as caught:
+        query.match(read_sensor_log(log), None, SceneOptions())
+    assert caught.value.one_line() == (
+        f"{log}: ego.acceleration is unknown: trace '{log.name}' has no acceleration for object 'ego' at frame 0"
+        " (the data records none; the reader's estimates from positions are not labels)"
+    )

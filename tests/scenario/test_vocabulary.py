@@ -202,8 +202,10 @@ def test_a_users_vocabulary_can_declare_its_own_any_primitive(tmp_path):
 def test_a_behaviour_nobody_defines_is_an_error_at_its_line_and_column(call):
     """As Scenic's NameError: a name neither the program nor the vocabulary defines is refused, not
     matched as a primitive no label stands for."""
-    body = f"ego = new Car with behavior {call}\n" if not call.startswith("do") else (
-        f"behavior Go():\n    {call}\nego = new Car with behavior Go()\n"
+    body = (
+        f"ego = new Car with behavior {call}\n"
+        if not call.startswith("do")
+        else (f"behavior Go():\n    {call}\nego = new Car with behavior Go()\n")
     )
     with pytest.raises(UserError, match=r"unknown behaviour \w+: the program does not define it") as caught:
         compile_scenario(HEADER + body)
@@ -214,5 +216,7 @@ def test_a_behaviour_nobody_defines_is_an_error_at_its_line_and_column(call):
 def test_a_users_vocabulary_can_name_its_own_primitive(tmp_path):
     path = tmp_path / "mine.toml"
     path.write_text('[Overtake]\nlabels = ["Overtake"]\n')
-    query = compile_scenario(HEADER + "ego = new Car with behavior OvertakeBehavior()\n", vocabulary=load_vocabulary(path))
+    query = compile_scenario(
+        HEADER + "ego = new Car with behavior OvertakeBehavior()\n", vocabulary=load_vocabulary(path)
+    )
     assert query.vocabulary.primitive("Overtake").labels == {"Overtake"}

@@ -172,6 +172,11 @@ class Explainer:
         start = int(np.argmax(joint))
         obj = min(per_object, key=lambda o: int(per_object[o][start]))
         survived = int(per_object[obj][start])
+        if obj in self.search.monitors:
+            return (
+                f"furthest reach with {self._names(assignment)}: over the window from {self.frame(start)}, "
+                f"the behaviours fit but {obj} does not hold"
+            )
         position = start + survived
         outputs = self.run(obj, assignment, start, survived + 1)[-1][1]
         ids = self.trace.objects.id

@@ -6,7 +6,8 @@
 
 Compilation: parse (Scenic's parser) -> IR -> the scene program (seed 003's
 resolution, used for the initial-scene check) -> one HFSM per program object
-(:mod:`.translate`) and one lazy automaton per HFSM (:mod:`.automaton`).
+(:mod:`.translate`) and one lazy automaton per HFSM (:mod:`.automaton`); temporal
+requirements become monitors (:mod:`.temporal`) run beside the HFSMs.
 Matching: :mod:`.search` over one trace's :class:`~.observations.Observations`.
 """
 
@@ -34,6 +35,7 @@ from .explain import Explainer
 from .hfsm import Hfsm
 from .observations import Observations
 from .search import Assignment, Outcome, Search
+from .temporal import Monitor, TemporalRequirement, compile_requirement
 from .translate import Guard, Translator
 from .vocabulary import Vocabulary, load_vocabulary
 
@@ -89,15 +91,18 @@ class ScenarioResult:
 
 @dataclass
 class ScenarioQuery:
-    """A compiled scenario program: its scene query, HFSMs, guards and vocabulary."""
+    """A compiled scenario program: its scene query, HFSMs, guards (behaviour conditions and the
+    conditions of temporal requirements), vocabulary and temporal requirements."""
 
     scene: SceneQuery
     hfsms: dict[str, Hfsm]
     guards: list[Guard]
     vocabulary: Vocabulary
+    requirements: list[TemporalRequirement] = field(default_factory=list)
     state_budget: int = MAX_STATES
     """Per HFSM, the most DFA states before its windows are simulated on configuration sets instead."""
     _automata: dict[tuple[str, float], Automaton] = field(default_factory=dict)
+    _monitors: dict[str, Monitor] = field(default_factory=dict)
 
     def uses_map(self) -> bool:
         return self.scene.uses_map() or any(term_layers(g.condition) for g in self.guards)
@@ -111,6 +116,14 @@ class ScenarioQuery:
                 self._automata[key] = Automaton(hfsm, len(self.guards), period, self.state_budget)
             found[name] = self._automata[key]
         return found
+
+    def monitors(self) -> dict[str, Monitor]:
+        """One monitor per temporal requirement, named by its text and line; kept."""
+        if len(self._monitors) < len(self.requirements):
+            for r in self.requirements:
+                name = f"{r.text} (line {r.span.line})"
+                self._monitors[name] = Monitor(r, name, self.state_budget)
+        return self._monitors
 
     def match(
         self,
@@ -158,7 +171,9 @@ class ScenarioQuery:
             return SceneResult(trace, scene, matches, labels_of(trace), geometry, scene_options_at)
 
         kinds = {name: objects[name].kinds for name in self.hfsms}
-        search = Search(self.hfsms, kinds, self.guards, automata, obs, m, scene_starts, options.find_all)
+        search = Search(
+            self.hfsms, kinds, self.guards, automata, obs, m, scene_starts, options.find_all, self.monitors()
+        )
         outcome: Outcome = search.run()
         matches = [
             ScenarioMatch({name: str(ids[row]) for name, row in assignment.items()}, starts)
@@ -223,8 +238,9 @@ def compile_scenario(
     soft = [r for r in scene.requirements if r.soft]
     translator = Translator(resolver, vocabulary or load_vocabulary())
     hfsms = {obj.name: translator.hfsm(obj) for obj in scene.objects}
+    requirements = [compile_requirement(translator, node, scope) for node, scope in resolver.temporal]
     scene_query = SceneQuery(scene, analyse(scene), soft, visible_distance)
-    return ScenarioQuery(scene_query, hfsms, translator.guards, translator.vocabulary)
+    return ScenarioQuery(scene_query, hfsms, translator.guards, translator.vocabulary, requirements)
 
 
 def load_scenario(

@@ -17,7 +17,11 @@
    correspondences extending a bad one); a complete one with starts left is a match.
 
 Reach vectors give, per window start, how many frames the HFSMs survive (capped at
-m); a start is alive while its reach is m.
+m); a start is alive while its reach is m. Temporal requirements (:mod:`.temporal`) are
+components like the HFSMs, without a label object of their own: a requirement is completed,
+and its monitor run on all candidates of the step at once, when the last object it reads is
+assigned (one that reads no object, at the root); its reach is m only where it holds over
+the window.
 """
 
 from __future__ import annotations
@@ -27,11 +31,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .automaton import Automaton, OverBudget, encode
+from .automaton import Automaton, LazyDfa, OverBudget, encode
 from .hfsm import BOTH, Hfsm
 from .matching import maximum_matching
 from .observations import Observations
 from .simulate import simulate_reach
+from .temporal import Monitor
 from .translate import Guard
 from .windows import table_reach
 
@@ -41,8 +46,8 @@ Assignment = dict[str, int]
 
 @dataclass
 class Node:
-    """A partial correspondence, its reach per window start (min over its objects), each object's
-    reach, and the starts still alive (behaviours reach m frames and the decided scene groups hold)."""
+    """A partial correspondence, its reach per window start (min over its components), each
+    component's reach (program objects and completed requirements), and the starts still alive (behaviours reach m frames and the decided scene groups hold)."""
 
     assignment: Assignment
     reach: np.ndarray
@@ -65,7 +70,8 @@ class Outcome:
 
 class Search:
     """One search over one trace; ``scene_starts(assignment, starts, newest)`` is the initial-scene
-    check of the scene groups an assignment decides that involve its newest object."""
+    check of the scene groups an assignment decides that involve its newest object; ``monitors``
+    are the temporal requirements' monitors by name."""
 
     def __init__(
         self,
@@ -77,8 +83,11 @@ class Search:
         window: int,
         scene_starts: Callable[[Assignment, np.ndarray, str], np.ndarray],
         find_all: bool,
+        monitors: dict[str, Monitor],
     ):
         self.hfsms = hfsms
+        self.monitors = monitors
+        self.components: dict[str, LazyDfa] = {**automata, **monitors}
         self.kinds = kinds
         self.guards = guards
         self.automata = automata
@@ -88,12 +97,14 @@ class Search:
         self.scene_starts = scene_starts
         self.find_all = find_all
         self.reads = {o: set().union({o}, *(guards[g].objects for g in h.guards)) for o, h in hfsms.items()}
+        self.reads.update({name: set(m.requirement.objects) for name, m in monitors.items()})
         self._memo: dict[tuple[str, tuple[tuple[str, int], ...]], np.ndarray] = {}
         self.outcome = Outcome()
 
     # ---------------------------------------------------------------- reach of one object
     def reach(self, obj: str, assignments: list[Assignment]) -> np.ndarray:
-        """(len(assignments), starts) reach of ``obj``'s HFSM; guards reading unassigned objects are BOTH."""
+        """(len(assignments), starts) reach of component ``obj`` (a program object's HFSM or a
+        requirement's monitor); guards reading unassigned objects are BOTH."""
         keys = [self._key(obj, a) for a in assignments]
         missing = list(dict.fromkeys(k for k in keys if k not in self._memo))
         if missing:
@@ -107,12 +118,16 @@ class Search:
         return obj, tuple(sorted((o, assignment[o]) for o in self.reads[obj] if o in assignment))
 
     def symbols(self, obj: str, assignments: list[Assignment]) -> np.ndarray:
-        """(len(assignments), frames) symbols of ``obj``'s automaton."""
-        automaton = self.automata[obj]
-        label = np.array([a[obj] for a in assignments], dtype=np.int64)
-        masks = self.obs.accept(automaton.outputs)[:, label].T
+        """(len(assignments), frames) symbols of component ``obj``'s automaton (no label bits for a
+        requirement)."""
+        automaton = self.components[obj]
+        if obj in self.monitors:
+            masks = np.zeros((len(assignments), self.obs.n_frames), dtype=np.int64)
+        else:
+            label = np.array([a[obj] for a in assignments], dtype=np.int64)
+            masks = self.obs.accept(automaton.outputs)[:, label].T
         codes = []
-        for g in self.hfsms[obj].guards:
+        for g in automaton.guards:
             guard = self.guards[g]
             value = np.full(masks.shape, BOTH, dtype=np.int64)
             bound = [j for j, a in enumerate(assignments) if all(o in a for o in guard.objects)]
@@ -126,7 +141,7 @@ class Search:
         """Reach per assignment and start: by the DFA's table, or by simulating configuration sets
         when the DFA is over its state budget or its step tables too large (:func:`.windows.table_reach`)."""
         symbols = self.symbols(obj, assignments)
-        automaton = self.automata[obj]
+        automaton = self.components[obj]
         if not automaton.over_budget:
             try:
                 return table_reach(automaton, symbols, self.m)[:, : self.n_starts]
@@ -148,8 +163,13 @@ class Search:
             out.feasible = False
             return out
         order = self._order(edges)
-        full = np.full(self.n_starts, self.m, dtype=np.int64)
-        for _ in self._extend(order, Node({}, full, {}, np.ones(self.n_starts, dtype=bool))):
+        root = Node({}, np.full(self.n_starts, self.m, dtype=np.int64), {}, np.ones(self.n_starts, dtype=bool))
+        for name in self.monitors:
+            if not self.reads[name]:
+                root.per_object[name] = self.reach(name, [{}])[0]
+                root.reach = np.minimum(root.reach, root.per_object[name])
+        root.alive = root.reach >= self.m
+        for _ in self._extend(order, root):
             if not self.find_all:
                 break
         return out
@@ -169,10 +189,13 @@ class Search:
     def _order(self, edges: dict[str, list[int]]) -> list[str]:
         """Dependency order: ego (else the most constrained object) first, then objects sharing guards."""
         linked = {o: set() for o in edges}
-        for o, reads in self.reads.items():
-            for p in reads - {o}:
+        for o in self.hfsms:
+            for p in self.reads[o] - {o}:
                 linked[o].add(p)
                 linked[p].add(o)
+        for name in self.monitors:
+            for o in self.reads[name]:
+                linked[o] |= self.reads[name] - {o}
         order: list[str] = []
         remaining = sorted(edges, key=lambda o: (o != "ego", len(edges[o]), o))
         while remaining:
@@ -197,7 +220,7 @@ class Search:
         used = set(node.assignment.values())
         cands = [c for c in out.unary[q] if c not in used]
         trials = [{**node.assignment, q: c} for c in cands]
-        completed = [o for o in order if q in self.reads[o] and self.reads[o] <= set(trials[0])] if trials else []
+        completed = [o for o in self.components if q in self.reads[o] and self.reads[o] <= set(trials[0])] if trials else []
         exact = {o: self.reach(o, trials) for o in completed}
         for j, (c, assignment) in enumerate(zip(cands, trials)):
             per_object = dict(node.per_object)

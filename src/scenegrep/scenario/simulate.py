@@ -1,13 +1,15 @@
 """Sliding windows without DFA states: the fallback when an HFSM's lazy DFA is over its budget.
 
 RE2 falls back from its DFA to an NFA simulation; here the NFA is the HFSM's configuration step
-(:meth:`.automaton.Automaton.successors`). Per frame, every configuration some run can be in
+(:meth:`.automaton.LazyDfa.successors`). Per frame, every configuration some run can be in
 carries the set of start frames whose run holds it, as one integer bit set: block r (``cap`` bits)
 belongs to row r of the symbols, and bit d of a block to the run that started d frames ago. A
 frame shifts every set by one bit (runs older than ``cap`` frames leave), adds the new starts to
 the initial configuration, and moves each set along the successors of the symbol of each of its
 rows. A start's run is alive while some configuration carries its bit, and runs never revive,
-so its reach is the age of its bit at the last frame it is seen.
+so its reach is the age of its bit at the last frame it is seen. With final acceptance (a
+temporal requirement's monitor), a run that survives ``cap`` frames must end in an accepting
+configuration, else its reach is ``cap - 1``.
 
 Time O(n · C · F) bit-set operations of k·cap bits for n frames, C configurations live at a
 frame and F distinct symbols at a frame over k rows; memory O(C · k · cap) bits. Linear in the
@@ -19,28 +21,37 @@ from __future__ import annotations
 
 import numpy as np
 
-from .automaton import Automaton
+from .automaton import LazyDfa
 from .hfsm import Config
 
 
-def simulate_reach(automaton: Automaton, symbols: np.ndarray, cap: int) -> np.ndarray:
+def simulate_reach(automaton: LazyDfa, symbols: np.ndarray, cap: int) -> np.ndarray:
     """(k, n) frames survived, at most ``cap``, from the initial configuration at each start frame
-    of each row of ``symbols`` (k, n): what :func:`.windows.reach` computes with the DFA's table."""
+    of each row of ``symbols`` (k, n): what :func:`.windows.table_reach` computes with the DFA's table."""
     k, n = symbols.shape
     lengths = np.zeros((k, n), dtype=np.int64)
     width = max(1, min(cap, n))
     blocks = [((1 << width) - 1) << (r * width) for r in range(k)]
     starts = sum(1 << (r * width) for r in range(k))
     keep = ((1 << (k * width)) - 1) & ~starts
+    oldest = sum(1 << (r * width + width - 1) for r in range(k))
+    refused = np.zeros((k, n), dtype=bool)
     carried: dict[Config, int] = {}
+    initial = automaton.initial
     for t in range(n):
         carried = {c: bits << 1 & keep for c, bits in carried.items()}
-        carried[None] = carried.get(None, 0) | starts
+        carried[initial] = carried.get(initial, 0) | starts
         carried = _step(automaton, carried, _row_sets(symbols[:, t], blocks))
-        alive = 0
-        for bits in carried.values():
+        alive = accepted = 0
+        for config, bits in carried.items():
             alive |= bits
+            if automaton.final_acceptance and automaton.accepting(config):
+                accepted |= bits
         _record(lengths, alive, t, k, width)
+        if automaton.final_acceptance and width == cap and t >= cap - 1:
+            ended = alive & oldest & ~accepted
+            refused[[r for r in range(k) if ended >> (r * width + width - 1) & 1], t - cap + 1] = True
+    lengths[refused] = cap - 1
     return lengths
 
 
@@ -53,7 +64,7 @@ def _row_sets(column: np.ndarray, blocks: list[int]) -> list[tuple[int, int]]:
     return list(zip(unique.tolist(), masks))
 
 
-def _step(automaton: Automaton, carried: dict[Config, int], rows: list[tuple[int, int]]) -> dict[Config, int]:
+def _step(automaton: LazyDfa, carried: dict[Config, int], rows: list[tuple[int, int]]) -> dict[Config, int]:
     """One frame: each configuration's start set moves to its successors under its rows' symbols."""
     after: dict[Config, int] = {}
     for config, bits in carried.items():

@@ -150,6 +150,31 @@ class Translator:
     # ---------------------------------------------------------------- conditions
     def guard(self, node: ir.Node, bindings: dict[str, Thunk], obj: str, used: set[int]) -> int:
         condition = expressions.to_bool(self.resolver, self.evaluate(node, bindings, obj), node)
+        known = self._register(condition, node)
+        used.add(known.index)
+        return known.index
+
+    def condition(self, node: ir.Node, scope: dict[str, Any]) -> int:
+        """The guard of a condition of a temporal requirement stated in ``scope`` (see
+        :mod:`.temporal`); one reading a random value is an error (Scenic draws it once per scene)."""
+        r = self.resolver
+        saved = r.scope
+        try:
+            r.scope = dict(scope)
+            condition = expressions.to_bool(r, expressions.evaluate(r, node), node)
+        finally:
+            r.scope = saved
+        known = self._register(condition, node)
+        if known.is_random:
+            raise self.error(
+                "a condition of a temporal requirement cannot read a random value: Scenic draws it once "
+                "per scene, so the monitor would need memory; give a constant",
+                node,
+            )
+        return known.index
+
+    def _register(self, condition: Term, node: ir.Node) -> Guard:
+        """The guard of a condition term (one per distinct term)."""
         known = self._by_term.get(condition)
         if known is None:
             f = self.resolver.f
@@ -159,8 +184,7 @@ class Translator:
             known = Guard(len(self.guards), condition, negation, objects, text, node.span)
             self.guards.append(known)
             self._by_term[condition] = known
-        used.add(known.index)
-        return known.index
+        return known
 
     def constant(self, node: ir.Node, bindings: dict[str, Thunk], obj: str) -> float:
         value = expressions.to_num(self.resolver, self.evaluate(node, bindings, obj), node)

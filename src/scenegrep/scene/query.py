@@ -193,6 +193,11 @@ def compile_scene(text: str, filename: str = "<program>", visible_distance: floa
     program = parse_program(text, filename)
     resolver = Resolver(program, visible_distance=visible_distance)
     scene = resolver.run()
+    if resolver.temporal:
+        raise resolver.error(
+            "temporal requirements need a scenario query (scenegrep scenario): a scene is one frame",
+            resolver.temporal[0][0].condition,
+        )
     soft = [r for r in scene.requirements if r.soft]
     return SceneQuery(scene, analyse(scene), soft, visible_distance)
 

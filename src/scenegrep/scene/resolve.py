@@ -85,6 +85,9 @@ class Resolver:
         self.self_view: Any = None
         self.behaviours: dict[str, ir.BehaviourDef] = {}
         """The program's behaviour definitions by name (they do not shape the scene; see :mod:`scenegrep.scenario`)."""
+        self.temporal: list[tuple[ir.Require, dict[str, Any]]] = []
+        """Requirements with temporal operators and the scope they were stated in (they do not shape
+        the initial scene; :mod:`scenegrep.scenario.temporal` monitors them over the window)."""
 
     def error(self, message: str, where: ir.Node | ir.Span) -> UserError:
         return program_error(message, where, self.program)
@@ -155,6 +158,11 @@ class Resolver:
         self.scope[node.name] = value
 
     def require(self, node: ir.Require) -> None:
+        if is_temporal(node.condition):
+            if node.probability is not None:
+                raise self.error("a soft requirement (require[p]) cannot use temporal operators", node)
+            self.temporal.append((node, dict(self.scope)))
+            return
         condition = expressions.to_bool(self, self.evaluate(node.condition, name=None), node.condition)
         if node.probability is not None and not 0 <= node.probability <= 1:
             raise self.error("a require probability must lie in [0, 1]", node)
@@ -245,3 +253,13 @@ def source_text(program: ir.Program, span: ir.Span) -> str:
 def resolve(program: ir.Program) -> SceneProgram:
     """The scene program of an IR program (see the module docstring)."""
     return Resolver(program).run()
+
+
+def is_temporal(node: ir.Node) -> bool:
+    """Whether a requirement's condition is temporal: a temporal operator, possibly under
+    ``and``, ``or`` and ``not`` (Scenic's propositions; anywhere else one is an error)."""
+    if isinstance(node, ir.Temporal):
+        return True
+    if isinstance(node, ir.BoolOp):
+        return any(is_temporal(o) for o in node.operands)
+    return isinstance(node, ir.Unary) and node.op == "not" and is_temporal(node.operand)

@@ -296,6 +296,21 @@ class Adapter:
         op = "and" if type(node.op).__name__ == "And" else "or"
         return ir.BoolOp(op, tuple(self.expr(v) for v in node.values), span=self.span(node))
 
+    def expr_Always(self, node: Any) -> ir.Node:
+        return ir.Temporal("always", (self.expr(node.value),), span=self.span(node))
+
+    def expr_Eventually(self, node: Any) -> ir.Node:
+        return ir.Temporal("eventually", (self.expr(node.value),), span=self.span(node))
+
+    def expr_Next(self, node: Any) -> ir.Node:
+        return ir.Temporal("next", (self.expr(node.value),), span=self.span(node))
+
+    def expr_UntilOp(self, node: Any) -> ir.Node:
+        return ir.Temporal("until", (self.expr(node.left), self.expr(node.right)), span=self.span(node))
+
+    def expr_ImpliesOp(self, node: Any) -> ir.Node:
+        return ir.Temporal("implies", (self.expr(node.hypothesis), self.expr(node.conclusion)), span=self.span(node))
+
     def expr_IfExp(self, node: Any) -> ir.Node:
         return ir.Conditional(self.expr(node.test), self.expr(node.body), self.expr(node.orelse), span=self.span(node))
 

@@ -111,6 +111,15 @@ class BoolOp(Node):
 
 
 @dataclass(frozen=True)
+class Temporal(Node):
+    """A temporal operator of a requirement: ``always``, ``eventually``, ``next`` (one operand),
+    ``until`` or ``implies`` (two: left, right)."""
+
+    op: str
+    operands: tuple[Node, ...]
+
+
+@dataclass(frozen=True)
 class Conditional(Node):
     """``body if test else orelse``."""
 

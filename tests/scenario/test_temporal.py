@@ -222,9 +222,11 @@ def test_a_window_of_the_whole_run_is_the_run():
     trace = trace_of([[(0.0, float(y)), (0.0, -12.0)] for y in EGO_Y], ids=("ego", "car1"))
     query = compile_scenario(f"{HEADER}require eventually {UP}\nrequire always {FAR}\n", "run.scenic")
     assert query.match(trace, "all", MAP).matched
-    assert not compile_scenario(f"{HEADER}require eventually (ego.position.y > 20)\n", "r.scenic").match(
-        trace, "all", MAP
-    ).matched
+    assert (
+        not compile_scenario(f"{HEADER}require eventually (ego.position.y > 20)\n", "r.scenic")
+        .match(trace, "all", MAP)
+        .matched
+    )
 
 
 def test_an_explanation_names_the_requirement_that_fails():

@@ -47,7 +47,8 @@ Assignment = dict[str, int]
 @dataclass
 class Node:
     """A partial correspondence, its reach per window start (min over its components), each
-    component's reach (program objects and completed requirements), and the starts still alive (behaviours reach m frames and the decided scene groups hold)."""
+    component's reach (program objects and completed requirements), and the starts still alive
+    (behaviours and requirements reach m frames and the decided scene groups hold)."""
 
     assignment: Assignment
     reach: np.ndarray
@@ -220,7 +221,9 @@ class Search:
         used = set(node.assignment.values())
         cands = [c for c in out.unary[q] if c not in used]
         trials = [{**node.assignment, q: c} for c in cands]
-        completed = [o for o in self.components if q in self.reads[o] and self.reads[o] <= set(trials[0])] if trials else []
+        completed = (
+            [o for o in self.components if q in self.reads[o] and self.reads[o] <= set(trials[0])] if trials else []
+        )
         exact = {o: self.reach(o, trials) for o in completed}
         for j, (c, assignment) in enumerate(zip(cands, trials)):
             per_object = dict(node.per_object)

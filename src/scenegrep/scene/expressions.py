@@ -608,6 +608,7 @@ _OPERATORS: dict[str, Callable[[Resolver, ir.Operator, list[Any]], Any]] = {
     **{name: _position_of for name in _SIDES},
 }
 
+
 def _temporal(r: Resolver, node: ir.Temporal) -> Any:
     raise r.error(
         f"'{node.op}' is a temporal operator: it may only appear in a 'require' of a scenario query, "

@@ -608,15 +608,6 @@ _OPERATORS: dict[str, Callable[[Resolver, ir.Operator, list[Any]], Any]] = {
     **{name: _position_of for name in _SIDES},
 }
 
-
-def _temporal(r: Resolver, node: ir.Temporal) -> Any:
-    raise r.error(
-        f"'{node.op}' is a temporal operator: it may only appear in a 'require' of a scenario query, "
-        "combined with and, or and not",
-        node,
-    )
-
-
 _HANDLERS: dict[type, Callable[[Resolver, Any], Any]] = {
     ir.Constant: _constant,
     ir.Name: _name,
@@ -626,7 +617,6 @@ _HANDLERS: dict[type, Callable[[Resolver, Any], Any]] = {
     ir.Binary: _binary,
     ir.Compare: _compare,
     ir.BoolOp: _bool_op,
-    ir.Temporal: _temporal,
     ir.Conditional: _conditional,
     ir.Attribute: _attribute,
     ir.Call: _call,

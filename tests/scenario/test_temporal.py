@@ -241,6 +241,10 @@ def test_an_explanation_names_the_requirement_that_fails():
     [
         ("require[0.5] always ego.position.y > 0", "4:1: a soft requirement (require[p]) cannot use temporal"),
         ("require always (distance to c) < Range(1, 5)", "4:16: a condition of a temporal requirement cannot read a"),
+        (
+            "require " + " and ".join(f"(always (c.position.y > {k}))" for k in range(25)),
+            "4:1: a temporal requirement may have at most 24 conditions",
+        ),
         # Scenic's grammar has temporal operators only in a requirement's propositions: elsewhere a call
         ("require (eventually (ego.position.y > 0)) + 1 > 0", "4:10: unknown or unsupported function 'eventually'"),
     ],

@@ -127,3 +127,5 @@ def test_cli_error_and_report(real_data, tmp_path, capsys):
         "scenegrep: --unknown-layers permissive: unknown map layers taken as everywhere; "
         "decisions affected: crossing 6725"
     ]
+    assert main(["scene", str(program), str(data), "--unknown-layers", "permissive", "--no-values", "-q"]) == 0
+    assert capsys.readouterr().err.splitlines() == err  # a second run in the process counts its own decisions

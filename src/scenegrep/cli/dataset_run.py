@@ -56,7 +56,10 @@ def run_query_command(
     from .. import readers
     from ..dataset import QuerySpec
 
+    from ..dataset.queries import spec_choice
+
     spec = QuerySpec.of(kind, query, origin, **options)
+    spec_choice(spec).decisions.clear()  # the choice is shared by the process; count this run's decisions
     if getattr(args, "map", None):
         readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
     printer = RowPrinter(args)
@@ -70,8 +73,6 @@ def run_query_command(
     if not args.quiet:
         _summary(results, where or (f"; results in {args.output}" if args.output else ""))
     if kind != "spre":
-        from ..dataset.queries import spec_choice
-
         report_unknown_layers(spec_choice(spec), counted=not args.dataset)
         if kind != "spre" and not counts["matched"]:
             _nearest_misses(spec, results, args)

@@ -229,7 +229,8 @@ def _spre_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap
 
 def spec_choice(spec: QuerySpec) -> Any:
     """The spec's choice for unknown map layers (checked when the spec was made), one object per
-    choice and process, so the road-map geometry built for it serves every trace on the same map."""
+    choice and process, so the road-map geometry built for it serves every trace on the same map;
+    its decision counts are the process's (a command's run clears them first)."""
     return _choice_of(spec.option("unknown_layers"))
 
 

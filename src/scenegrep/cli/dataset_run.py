@@ -59,7 +59,8 @@ def run_query_command(
     from ..dataset.queries import spec_choice
 
     spec = QuerySpec.of(kind, query, origin, **options)
-    spec_choice(spec).decisions.clear()  # the choice is shared by the process; count this run's decisions
+    if kind != "spre":
+        spec_choice(spec).decisions.clear()  # the choice is shared by the process; count this run's decisions
     if getattr(args, "map", None):
         readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
     printer = RowPrinter(args)

@@ -55,12 +55,12 @@ def run_query_command(
     """Run a query over ``paths`` or ``args.dataset``, print its results; returns the exit code."""
     from .. import readers
     from ..dataset import QuerySpec
-
     from ..dataset.queries import spec_choice
 
     spec = QuerySpec.of(kind, query, origin, **options)
-    if kind != "spre":
-        spec_choice(spec).decisions.clear()  # the choice is shared by the process; count this run's decisions
+    choice = None if kind == "spre" else spec_choice(spec)
+    if choice is not None:
+        choice.decisions.clear()  # the choice is shared by the process; count this run's decisions
     if getattr(args, "map", None):
         readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
     printer = RowPrinter(args)
@@ -73,9 +73,9 @@ def run_query_command(
     counts = results.counts()
     if not args.quiet:
         _summary(results, where or (f"; results in {args.output}" if args.output else ""))
-    if kind != "spre":
-        report_unknown_layers(spec_choice(spec), counted=not args.dataset)
-        if kind != "spre" and not counts["matched"]:
+    if choice is not None:
+        report_unknown_layers(choice, counted=not args.dataset)
+        if not counts["matched"]:
             _nearest_misses(spec, results, args)
     if results.status == "interrupted":
         return EXIT_INTERRUPTED

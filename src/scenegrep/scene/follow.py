@@ -48,16 +48,24 @@ def steps_for(distance) -> np.ndarray:
 
 def follow_field(ev: Evaluator, term: Term) -> np.ndarray:
     """One coordinate (``term.value[1]``: 0 = x, 1 = y) of the walk's end, for every row."""
-    x, y, distance = (np.array(a, dtype=float) for a in ev._args(term))
+    x, y, distance = ev._args(term)
     field, axis = term.value
+    end = walk_end(ev.geometry, field, x, y, distance, ev.value)
+    return end[0] if axis == 0 else end[1]
+
+
+def walk_end(geometry, field, x, y, distance, value) -> tuple[np.ndarray, np.ndarray]:
+    """The end (x, y, metres) of Scenic's walk along the field from each (x[i], y[i]) for
+    ``distance[i]`` metres."""
+    x, y, distance = (np.array(a, dtype=float) for a in (x, y, distance))
     steps = steps_for(distance)
     step = distance / steps
     for k in range(int(steps.max(initial=0))):
         active = np.flatnonzero(k < steps)
-        heading = ev.geometry.scenic_headings(field, x[active], y[active], ev.value)
+        heading = geometry.scenic_headings(field, x[active], y[active], value)
         x[active] += -np.sin(heading) * step[active]
         y[active] += np.cos(heading) * step[active]
-    return x if axis == 0 else y
+    return x, y
 
 
 def follow_box(geometry, field, x, y, distance, value, covering_arc, intervals):

@@ -81,6 +81,7 @@ class Linework:
     pair_reach: np.ndarray
     pair_tree: shapely.STRtree
     polylines: Polylines
+    segments: np.ndarray
 
 
 class _Columns:
@@ -132,7 +133,8 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     tree = shapely.STRtree(shapely.linestrings(np.stack([start, end], axis=1)))
     pairs, lanes, boxes = _competing_pairs(polylines, reach)
     near = reach[lanes] + REACH_MARGIN_M
-    return Linework(start, end, tree, pairs, lanes, near, shapely.STRtree(boxes), polylines)
+    segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
+    return Linework(start, end, tree, pairs, lanes, near, shapely.STRtree(boxes), polylines, segments)
 
 
 def _competing_pairs(polylines: Polylines, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -187,12 +189,38 @@ def crossings(lw: Linework, px, py, qx, qy) -> tuple[np.ndarray, np.ndarray]:
     segments = shapely.linestrings(np.stack([p, p + r], axis=1))
     walk, line = lw.tree.query(segments)
     found_walk, found_t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
-    walk_pairs, pair = lw.pair_tree.query(segments)
-    tie_t, tie = _equal_distances(lw, p[walk_pairs], r[walk_pairs], pair) if len(pair) else (found_t[:0], walk[:0])
-    found_walk = np.concatenate([walk[found_walk], walk_pairs[tie]])
+    tie_walk, tie_t, _ = _ties(lw, p, r, segments)
+    found_walk = np.concatenate([walk[found_walk], tie_walk])
     found_t = np.concatenate([found_t, tie_t])
     inside = (found_t > 0) & (found_t < 1)
     return index[found_walk[inside]], found_t[inside]
+
+
+def ties(lw: Linework, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(segment index, flat index of a centreline segment) pairs: along the segment from
+    ``start[i]`` to ``end[i]`` (rows of x, y; metres) that centreline segment and a competing one
+    (both given) become equally near strictly inside, where the heading may change along a curve
+    rather than at the straight linework."""
+    r = end - start
+    moving = np.flatnonzero(np.hypot(r[:, 0], r[:, 1]) > DEGENERATE_M)
+    p, r = start[moving], r[moving]
+    walk, t, pair = _ties(lw, p, r, shapely.linestrings(np.stack([p, p + r], axis=1)))
+    inside = (t > 0) & (t < 1)
+    walk, pair = moving[walk[inside]], pair[inside]
+    return np.concatenate([walk, walk]), np.concatenate([lw.pairs[pair, 0], lw.pairs[pair, 1]])
+
+
+def _ties(lw: Linework, p: np.ndarray, r: np.ndarray, segments: np.ndarray):
+    """(segment index, t, pair index) where the two segments of a competing pair are equally near
+    p + t r."""
+    walk, pair = lw.pair_tree.query(segments)
+    for side in (0, 1):
+        near = shapely.dwithin(segments[walk], lw.segments[lw.pairs[pair, side]], lw.pair_reach[pair])
+        walk, pair = walk[near], pair[near]
+    if not len(pair):
+        return walk, np.zeros(0), pair
+    tie_t, tie = _equal_distances(lw, p[walk], r[walk], pair)
+    return walk[tie], tie_t, pair[tie]
 
 
 def _segment_crossings(p, r, a, s) -> tuple[np.ndarray, np.ndarray]:

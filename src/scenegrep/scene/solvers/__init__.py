@@ -14,7 +14,9 @@
    z3 times out.
 
 A row that follows ``roadDirection`` from a known start for a random distance skips these
-steps: :mod:`.walk` decides it exactly over the pieces of the walk, with a witness.
+steps: :mod:`.walk` decides it exactly over the pieces of the walk, with a witness; one that
+follows it from a random point on a curb goes first to :mod:`.walk_start` (exact, with a
+witness), and to these steps only where that leaves it undecided.
 
 The row is feasible when one piece is. Solver verdicts other than a proof of
 infeasibility keep the row (soundness first); ``delta-sat`` and ``undecided``
@@ -38,6 +40,7 @@ from .pointwise import satisfies
 from .problem import Bound, PointUnknown, Problem, build
 from ..follow_pieces import Pieces
 from .walk import Walk, find_walk, solve_walk, walk_pieces
+from .walk_start import find_curb_walk, solve_curb_walk
 
 
 def decide_rows(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
@@ -70,6 +73,11 @@ def solve(
     if walk is not None:
         pieces = pieces or walk_pieces([problem], [walk], geometry)[0]
         return solve_walk(problem, walk, pieces, lambda piece, boxes: _solve_piece(piece, geometry, boxes, delta))
+    curb_walk = find_curb_walk(problem)
+    if curb_walk is not None:
+        outcome = solve_curb_walk(problem, curb_walk, geometry)
+        if outcome.status != "undecided":
+            return outcome
     search = BranchAndPrune(problem, geometry, delta)
     box = search.initial_box()
     box = None if box is None else search.contract(box)

@@ -1,0 +1,131 @@
+"""Exact decision, with a witness, of a row whose object follows ``roadDirection`` from a random
+point on a curb for a random distance (``spot = new OrientedPoint on curb`` then ``following
+roadDirection from spot for Range(-30, -20)``).
+
+A row qualifies when its only unknowns are the curb point and the distance D (a finite range),
+every ``follow`` term walks from that point for D over the lanes field, and every bound is on
+the walk's end (its x, its y, its heading: the road direction there), the end boxed in x and y.
+Only curb segments within max |D| of the end's box can start a walk ending there (a walk of n
+steps of |D| / n metres); for each, :func:`~..follow_regions.start_regions` gives every (s, D)
+whose walk ends in the box, grouped by heading sequence and end heading, exactly. A region whose
+end heading meets the heading bounds holds the solutions: its interior point (s, D) is the
+witness, walked again with Scenic's rule (:func:`~..follow.walk_end`) and checked against the
+row's whole system (:func:`.pointwise.satisfies`, requirements included) before it is reported.
+
+The row is undecided (the caller falls back to the general solvers) when the enumeration is not
+exact there (:class:`~..follow_regions.Unsure`: folded centrelines competing inside a region, a
+walk point near a shoulder, whose direction the map model does not hold) or when no candidate
+witness passes the check.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+
+from ..follow import MAX_STEPS, STEP_M, walk_end
+from ..follow_regions import StartRegion, Unsure, start_regions
+from ..geometry import MapGeometry
+from ..regions import MapRegion
+from ..terms import Term
+from .branch_prune import Outcome
+from .pointwise import bound_violation, satisfies
+from .problem import PointUnknown, Problem
+from .walk import ROAD_DIRECTION, _follow_terms
+
+SCENIC_TOLERANCE_M = 0.05
+"""Scenic's road network finds an element within this distance of a point when none holds it
+(``Network.tolerance`` of OpenDRIVE maps): walk points this near a shoulder are avoided."""
+
+
+@dataclass(frozen=True)
+class CurbWalk:
+    """The one walk of a row: its start point on a curb, distance unknown and range (metres), the
+    end's coordinate terms (x, y), and the box its bounds give the end (x_lo, x_hi, y_lo, y_hi)."""
+
+    point: PointUnknown
+    distance: Term
+    ends: tuple[Term, Term]
+    lo: float
+    hi: float
+    box: tuple[float, float, float, float]
+
+
+def find_curb_walk(problem: Problem) -> CurbWalk | None:
+    """The row's walk when it qualifies (see the module docstring), else None."""
+    found = sorted(_follow_terms(problem), key=lambda t: t.value[1])
+    if len(found) != 2 or found[0].args != found[1].args or len(problem.points) != 1:
+        return None
+    x, y, distance = found[0].args
+    point = problem.points[0]
+    if (point.x, point.y) != (x, y) or point.region != MapRegion("curb") or problem.scalars != [distance]:
+        return None
+    if any(t.value[0] != ROAD_DIRECTION for t in found):
+        return None
+    lo, hi = problem.ranges[distance]
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi and max(-lo, hi) <= STEP_M * MAX_STEPS):
+        return None
+    ends = (found[0], found[1])
+    box = [-math.inf, math.inf, -math.inf, math.inf]
+    for bound in problem.bounds:
+        if bound.term in ends and not bound.angle:
+            axis = bound.term.value[1]
+            box[2 * axis], box[2 * axis + 1] = max(box[2 * axis], bound.lo), min(box[2 * axis + 1], bound.hi)
+        elif not _is_end_heading(bound.term, ends):
+            return None
+    if not all(math.isfinite(v) for v in box):
+        return None
+    return CurbWalk(point, distance, ends, lo, hi, (box[0], box[1], box[2], box[3]))
+
+
+def _is_end_heading(term: Term, ends: tuple[Term, Term]) -> bool:
+    return term.op == "field" and term.value == ROAD_DIRECTION and tuple(term.args) == ends
+
+
+def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> Outcome:
+    """Decide the row over the regions of its walk (see the module docstring)."""
+    road_map = geometry._require_map()
+    curbs = road_map.curb_polylines
+    x0, x1, y0, y1 = walk.box
+    reach = max(-walk.lo, walk.hi)
+    near = np.flatnonzero(
+        shapely.dwithin(
+            shapely.linestrings(np.stack([curbs.start, curbs.end], axis=1)), shapely.box(x0, y0, x1, y1), reach + 1e-9
+        )
+    )
+    shoulders = [a.polygon for a in road_map.shoulders]
+    avoid = shapely.buffer(shapely.union_all(shoulders), SCENIC_TOLERANCE_M) if shoulders else None
+    try:
+        regions = start_regions(
+            geometry, ROAD_DIRECTION, curbs.start[near], curbs.end[near], walk.lo, walk.hi, walk.box, avoid
+        )
+    except Unsure:
+        return Outcome("undecided", None, "follow-start")
+    headings = [b for b in problem.bounds if _is_end_heading(b.term, walk.ends)]
+    candidates = [r for r in regions if all(bound_violation(r.heading, b) == 0 for b in headings)]
+    for region in candidates:
+        segment = near[region.segment]
+        witness = _checked_witness(problem, walk, geometry, curbs.start[segment], curbs.end[segment], region)
+        if witness is not None:
+            return Outcome("sat", witness, "follow-start")
+    return Outcome("undecided" if candidates else "unsat", None, "follow-start")
+
+
+def _checked_witness(
+    problem: Problem, walk: CurbWalk, geometry: MapGeometry, a: np.ndarray, b: np.ndarray, region: StartRegion
+) -> dict[Term, float] | None:
+    """The region's interior point (or centroid) as an assignment, when Scenic's walk from it
+    meets the row's whole system; else None."""
+    direction = (b - a) / np.hypot(*(b - a))
+    for point in (shapely.point_on_surface(region.shape), shapely.centroid(region.shape)):
+        s, d = shapely.get_x(point), shapely.get_y(point)
+        x, y = a + s * direction
+        end_x, end_y = walk_end(geometry, ROAD_DIRECTION, [x], [y], [d], None)
+        assignment = {walk.distance: float(d), walk.point.x: float(x), walk.point.y: float(y)}
+        walked = {**assignment, walk.ends[0]: float(end_x[0]), walk.ends[1]: float(end_y[0])}
+        if satisfies(problem, geometry, walked):
+            return assignment
+    return None

@@ -13,6 +13,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -164,3 +165,43 @@ def test_labels_no_start_can_produce_do_not_match():
         assert not match(lo, hi, label, 1e-4)[0]
     moved = (float(ex[0]) + 3 * across[0], float(ey[0]) + 3 * across[1], heading)
     assert match(lo, hi, moved, 1e-4)[1]["follow-start:unsat"] == 1
+
+
+@pytest.mark.slow
+@pytest.mark.real_data
+def test_scenic_samples_from_town01_curbs_match_with_witnesses_and_perturbations_do_not(maps_dir):
+    """Scenic 3.1.1's own scenes of examples/scenes/following_curb.scenic: each matches through
+    this path with a witness whose walk (Scenic's rule) ends at the label; moved 3 m across its
+    heading or turned by 0.3 rad, none matches (the moved ones refuted here, exactly)."""
+    from pathlib import Path
+
+    from scenegrep.readers.opendrive import read_map
+    from scenegrep.scene import load_scene
+    from scenegrep.scene.follow import walk_end
+    from scenegrep.scene.geometry import geometry_of
+    from scenegrep.synth.ground_truth import perturbed
+    from scenegrep.synth.scenic_scenes import sample_scenes
+
+    program = Path(__file__).resolve().parents[2] / "examples" / "scenes" / "following_curb.scenic"
+    town = maps_dir / "Town01.xodr"
+    trace = sample_scenes(program, 30, map_path=town, seed=5)
+    road_map = read_map(town)
+    geometry = geometry_of(road_map)
+    query = load_scene(program)
+    options = SceneOptions(Tolerance(), correspondence={"ego": "ego", "otherCar": "obj1"})
+    result = query.match(trace, road_map, options)
+    assert result.matched.all()
+    assert result.matches.notes["follow-start:sat"] == trace.n_frames
+    car = trace.states.object == trace.object_index("obj1")
+    for frame in range(trace.n_frames):
+        values = result.values(frame)
+        distance = values["Range(-30, -20)@7:58"]
+        x, y = values["point on: on curb@6:26"]
+        end_x, end_y = walk_end(geometry, FIELD, [x], [y], [distance], None)
+        row = np.flatnonzero(car & (trace.states.frame == frame))[0]
+        assert abs(end_x[0] - trace.states.x[row]) <= 1e-6 and abs(end_y[0] - trace.states.y[row]) <= 1e-6
+    moved = query.match(perturbed(trace, "obj1", "lateral", 3.0), road_map, options)
+    assert not moved.matched.any()
+    assert moved.matches.notes["follow-start:unsat"] == trace.n_frames
+    turned = query.match(perturbed(trace, "obj1", "heading", 0.3), road_map, options)
+    assert not turned.matched.any()

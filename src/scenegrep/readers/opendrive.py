@@ -27,8 +27,8 @@ the inverse links. A lane's left/right neighbour is that of its first lane
 section having one, with same direction when both sections run the same way.
 Roads, intersections (holding their maneuvers' connecting lanes), crossings,
 sidewalks, shoulders, the curbs of ordinary roads and the drivable region come over
-as they are in Scenic; sidewalks and crossings keep their centrelines (which orient them) and
-Scenic's order. Scenic 3.1.1's OpenDRIVE parser makes no crossings (its ``crossings = ()``), so
+as they are in Scenic; sidewalks, crossings and shoulders keep their centrelines (which orient
+them) and Scenic's order. Scenic 3.1.1's OpenDRIVE parser makes no crossings (its ``crossings = ()``), so
 the crossing layer of every OpenDRIVE map is empty.
 """
 
@@ -55,7 +55,7 @@ FORMAT = "opendrive"
 UNKNOWN_LAYERS: frozenset[str] = frozenset()
 """Scenic's road network publishes every layer (crossings, sidewalks, curbs, shoulders), so an
 OpenDRIVE map without, say, sidewalks has an empty sidewalk layer, as in Scenic."""
-CONVERSION_VERSION = 5
+CONVERSION_VERSION = 6
 """Bumped whenever the conversion changes, so cached maps are rebuilt."""
 
 
@@ -104,13 +104,9 @@ def _curbs(network: Any) -> tuple[np.ndarray, ...]:
     return tuple(np.asarray(g.curb.points, dtype=np.float64)[:, :2] for g in groups)
 
 
-def _areas(elements: Any) -> tuple[Area, ...]:
-    return tuple(Area(e.uid, e.polygons) for e in elements)
-
-
 def _oriented_areas(elements: Any) -> tuple[Area, ...]:
-    """Sidewalks or crossings with their centrelines, in Scenic's order (its union's orientation
-    takes the first element containing a point)."""
+    """Sidewalks, crossings or shoulders with their centrelines, in Scenic's order (its union's
+    orientation, and its road direction on shoulders, take the first element containing a point)."""
     return tuple(
         Area(e.uid, e.polygons, centreline=np.asarray(e.centerline.points, np.float64)[:, :2]) for e in elements
     )
@@ -133,7 +129,7 @@ def convert_network(network: Any, name: str, source: str) -> RoadMap:
         _curbs(network),
         network.drivableRegion.polygons,
         source,
-        _areas(network.shoulders),
+        _oriented_areas(network.shoulders),
         UNKNOWN_LAYERS,
     )
 

@@ -9,10 +9,13 @@ object's heading is the field at the end. Headings are those of :mod:`.geometry`
 :meth:`~.geometry.MapGeometry.field_values` at the end).
 
 The field ``roadDirection`` is piecewise constant: a point takes the heading of one centreline
-segment of the lane (or intersection lane) holding it, or 0 off the lanes. The heading can only
-change where a point crosses the *linework*: a lane or intersection boundary; at each interior
-vertex of a centreline, its two segment normals and their bisector (where the projection onto
-the centreline passes the vertex or jumps across the inner side), reaching 1 m beyond the lane;
+segment of the lane (or intersection lane) holding it, off the lanes of a shoulder's centreline,
+or of the element within Scenic's 5 cm tolerance, or 0. The heading can only change where a
+point crosses the *linework*: a lane, intersection or shoulder boundary, or the boundary of the
+band within 5 cm of the lanes, of the intersections or of the shoulders (buffers of their unions);
+at each interior vertex of a centreline (a lane's or a shoulder's), its two segment normals and
+their bisector (where the projection onto the centreline passes the vertex or jumps across the
+inner side), reaching 1 m beyond the lane or shoulder;
 or, where a centreline turns by more than 90° within twice its reach (the lane's half width
 plus 1 m; folds where lane sections join, sharp bends), a point equally near two non-adjacent
 segments and nearer than the rest (roots of a difference of squared distances, piecewise
@@ -30,9 +33,11 @@ Exact up to the boundaries between pieces (D values where a walk point lies on t
 a finite set), with two assumptions: non-adjacent centreline segments compete only across a
 turn of more than 90° (true when the centreline's radius of curvature exceeds the lane's half
 width; tests walk Town01 and Town06 at random against the step-by-step walk); and where a point
-lies in no lane but inside an intersection area, or (for the end heading) off every lane, the
-*nearest* lane's direction is read at the piece's midpoint, i.e. the nearest lane is assumed not
-to change inside a piece.
+lies in no lane but inside an intersection area or within 5 cm of a lane or intersection, or
+(for the end heading) off every lane, the *nearest* lane's direction is read at the piece's
+midpoint, i.e. the nearest lane is assumed not to change inside a piece (shoulder centrelines,
+too, are assumed not to fold; the 5 cm bands are shapely's buffers, polygons within 0.1 mm of
+Scenic's round ones).
 """
 
 from __future__ import annotations
@@ -46,7 +51,7 @@ import shapely
 
 from .follow import MIN_STEPS, STEP_M, steps_for
 from ..model.polylines import Polylines
-from .geometry import MapGeometry
+from .geometry import ELEMENT_REACH_M, MapGeometry
 from .regions import Field
 
 REACH_MARGIN_M = 1.0
@@ -71,7 +76,8 @@ SLACK = 1e-9
 class Linework:
     """Where ``roadDirection`` may change (see the module docstring): segments with an R-tree, and
     pairs of non-adjacent centreline segments of one lane that may compete for a point, with an
-    R-tree of the boxes where they may (within the lane's reach of both)."""
+    R-tree of the boxes where they may (within the lane's reach of both); the centreline segments
+    as lines."""
 
     start: np.ndarray
     end: np.ndarray
@@ -115,7 +121,11 @@ def linework(geometry: MapGeometry) -> Linework:
 
 def _build_linework(geometry: MapGeometry) -> Linework:
     road_map = geometry._require_map()
-    areas = list(road_map.lane_polygons) + [a.polygon for a in road_map.intersections]
+    shoulders = [a.polygon for a in road_map.shoulders]
+    intersections = [a.polygon for a in road_map.intersections]
+    areas = list(road_map.lane_polygons) + intersections + shoulders
+    bands = [list(road_map.lane_polygons), intersections, shoulders]
+    areas += [shapely.buffer(shapely.union_all(band), ELEMENT_REACH_M) for band in bands if band]
     starts, ends = [np.zeros((0, 2))], [np.zeros((0, 2))]
     for ring in shapely.get_rings(shapely.get_parts(np.array(areas, dtype=object))):
         coords = shapely.get_coordinates(ring)
@@ -123,8 +133,13 @@ def _build_linework(geometry: MapGeometry) -> Linework:
         ends.append(coords[1:])
     polylines = road_map.centreline_polylines
     reach = shapely.hausdorff_distance(shapely.boundary(road_map.lane_polygons), polylines.geometries)
-    for line, length in enumerate((reach + REACH_MARGIN_M).tolist()):
-        vertex_starts, vertex_ends = _vertex_lines(polylines.lines[line], length)
+    lines = list(zip(polylines.lines, (reach + REACH_MARGIN_M).tolist()))
+    if all(a.centreline is not None for a in road_map.shoulders):
+        centres = Polylines([a.centreline for a in road_map.shoulders])
+        near = shapely.hausdorff_distance(shapely.boundary(np.array(shoulders, dtype=object)), centres.geometries)
+        lines += list(zip(centres.lines, (near + REACH_MARGIN_M).tolist()))
+    for line, length in lines:
+        vertex_starts, vertex_ends = _vertex_lines(line, length)
         starts.append(vertex_starts)
         ends.append(vertex_ends)
     start, end = np.concatenate(starts), np.concatenate(ends)

@@ -23,12 +23,12 @@ last step the end is clipped to the box itself and cut once more, reading every 
 has at the end (:meth:`~.geometry.MapGeometry.field_values`); the result is exact: the final
 regions are every (s, D) whose walk ends in the box, grouped by heading sequence and end value.
 
-The enumeration refuses (:class:`Unsure`) where this is not exact: a face along whose edges two
-competing centreline segments become equally near (the heading may change along a curve inside),
-and a walk point that may come near an area the caller names (``avoid``; the solver names
-shoulders, where Scenic takes a direction the map model does not hold). Where the nearest lane
-counts (in an intersection area between its lanes) it is read at the face's interior point, the
-assumption :mod:`.follow_pieces` makes per piece.
+Where two competing segments of a folded centreline become equally near along a face's edges
+(the heading may change along a curve through the face, not at the straight linework) the face
+takes each of their headings as well as the one read inside: the regions then cover every walk
+but may hold (s, D) that walk otherwise, so the solver walks its witnesses again. Where the
+nearest lane counts (in an intersection area between its lanes, within 5 cm of a lane) it is
+read at the face's interior point, the assumption :mod:`.follow_pieces` makes per piece.
 """
 
 from __future__ import annotations
@@ -48,10 +48,6 @@ TIE_M = 1e-9
 
 DIRECTIONS = np.array([[1.0, 0.0], [0.0, 1.0], [np.sqrt(0.5), np.sqrt(0.5)], [np.sqrt(0.5), -np.sqrt(0.5)]])
 """Unit directions whose projections bound where a walk point can still reach the target box."""
-
-
-class Unsure(Exception):
-    """The enumeration cannot be exact here (see the module docstring): the caller falls back."""
 
 
 @dataclass
@@ -84,11 +80,10 @@ def start_regions(
     lo: float,
     hi: float,
     target: tuple[float, float, float, float],
-    avoid: shapely.Geometry | None = None,
 ) -> list[StartRegion]:
     """The final regions (see the module docstring) of the walks from every point of the segments
     ``start[i]``-``end[i]`` (rows of x, y) for every D in [lo, hi] (metres, lo < hi) that end in the
-    box ``target`` (x_lo, x_hi, y_lo, y_hi); raises :class:`Unsure` where that is not exact."""
+    box ``target`` (x_lo, x_hi, y_lo, y_hi)."""
     lw = linework(geometry)
     box = np.array([[target[0], target[2]], [target[1], target[2]], [target[0], target[3]], [target[1], target[3]]])
     project = box @ DIRECTIONS.T
@@ -108,13 +103,11 @@ def start_regions(
                 moved = []
                 for shape, c in branches:
                     shape = _clip(shape, *_reach(seg, c, sign * (steps - k) / steps, window))
-                    _check_clear(seg, c, shape, avoid)
                     for part, heading in _faces(lw, geometry, field, seg, c, shape, last=False):
                         moved.append((part, c + np.array([-np.sin(heading), np.cos(heading)]) / steps))
                 branches = moved
             for shape, c in branches:
                 shape = _clip(shape, *_reach(seg, c, 0.0, window))
-                _check_clear(seg, c, shape, avoid)
                 for part, heading in _faces(lw, geometry, field, seg, c, shape, last=True):
                     found.append(StartRegion(index, steps, c, heading, part))
     return found
@@ -180,15 +173,6 @@ def _image(seg: _Start, c: np.ndarray, points: np.ndarray) -> np.ndarray:
     return seg.a + points[:, :1] * seg.e + points[:, 1:2] * c
 
 
-def _check_clear(seg: _Start, c: np.ndarray, shape: shapely.Geometry, avoid: shapely.Geometry | None) -> None:
-    """Raise :class:`Unsure` when the walk points of the region may meet ``avoid``."""
-    if avoid is None or shape.is_empty:
-        return
-    hull = shapely.convex_hull(shapely.multipoints(_image(seg, c, shapely.get_coordinates(shape))))
-    if shapely.intersects(avoid, hull):
-        raise Unsure("a walk point may lie on an area the map model does not orient as Scenic does")
-
-
 def _faces(lw: Linework, geometry: MapGeometry, field: Field, seg: _Start, c: np.ndarray, shape, last: bool):
     """(part of the region, heading) pairs: the region cut where the walk point crosses the
     linework, faces joined by heading (Scenic's step heading, or with ``last`` every value of the
@@ -219,6 +203,7 @@ def _cut_by_linework(lw: Linework, seg: _Start, c: np.ndarray, shape: shapely.Ge
     corners = _image(seg, c, np.array([[s0, d0], [s1, d0], [s0, d1], [s1, d1]]))
     near = lw.tree.query(shapely.box(*corners.min(axis=0), *corners.max(axis=0)))
     lines = _preimages(lw.start[near], lw.end[near], seg, c, (s0 - 1, d0 - 1, s1 + 1, d1 + 1))
+    lines = lines[shapely.intersects(shape, lines)]
     if not len(lines):
         return shapely.get_parts(shape)
     noded = shapely.union_all(np.append(lines, shapely.boundary(shape)))
@@ -283,9 +268,18 @@ def _tie_headings(lw: Linework, seg: _Start, c: np.ndarray, faces: np.ndarray) -
     coords, owner = shapely.get_coordinates(shapely.get_rings(faces), return_index=True)
     ring_face = np.repeat(np.arange(len(faces)), shapely.get_num_interior_rings(faces) + 1)
     same = owner[1:] == owner[:-1]
-    xy = _image(seg, c, coords)
-    edge, segment = ties(lw, xy[:-1][same], xy[1:][same])
-    return ring_face[owner[:-1][same][edge]], lw.polylines.heading[segment]
+    edges = np.concatenate([coords[:-1][same], coords[1:][same]], axis=1)
+    face = ring_face[owner[:-1][same]]
+    # an edge two faces share is checked once (either direction)
+    key = np.where((edges[:, :2] <= edges[:, 2:]).all(axis=1, keepdims=True), edges, edges[:, [2, 3, 0, 1]])
+    unique, back = np.unique(key, axis=0, return_inverse=True)
+    edge, segment = ties(lw, _image(seg, c, unique[:, :2]), _image(seg, c, unique[:, 2:]))
+    hit = np.isin(back.ravel(), edge)
+    if not hit.any():
+        return face[:0], np.zeros(0)
+    which = {e: segment[edge == e] for e in np.unique(edge).tolist()}
+    rows = [(f, h) for f, e in zip(face[hit].tolist(), back.ravel()[hit].tolist()) for h in which[e].tolist()]
+    return np.array([r[0] for r in rows], dtype=np.intp), lw.polylines.heading[np.array([r[1] for r in rows])]
 
 
 def _no_terms(term):

@@ -401,6 +401,10 @@ class MapGeometry:
         missing = np.setdiff1d(np.arange(len(x)), rows)
         if len(missing):
             rows, headings = _off_lane(road_map, x, y, missing, rows, headings)
+            scenic = self._off_lanes(x[missing], y[missing])
+            rows, headings = np.concatenate([rows, missing]), np.concatenate([headings, scenic])
+            order = np.argsort(rows, kind="stable")
+            rows, headings = rows[order], headings[order]
         return rows, headings
 
     def _elements(self, name: str) -> tuple[STRtree, Polylines]:
@@ -473,10 +477,12 @@ class MapGeometry:
 
         Scenic's ``roadDirection`` takes the first intersection containing the point and, there, the
         first of its connecting lanes (in maneuver order) containing it, else the nearest; elsewhere
-        the first lane containing the point; outside every lane 0. Exact on OpenDRIVE maps, whose
-        intersections keep Scenic's maneuver order, except on shoulders and on road area outside
-        every lane, where Scenic takes the element's own centreline direction (the map model holds
-        no shoulder or road centrelines) and this gives 0.
+        the first lane containing the point; outside every lane the first shoulder holding it (along
+        its centreline), else the first element within Scenic's tolerance (:meth:`_off_lanes`), else
+        0. Exact on OpenDRIVE maps, whose intersections keep Scenic's maneuver order, except on road
+        area outside every lane (0.3 m² on Town01), where Scenic takes the road's own centreline
+        direction (the map model holds no road centrelines) and this gives 0, and within the
+        tolerance of a road, where it takes the nearest lane for the first of Scenic's lanes there.
         """
         if not (isinstance(field, MapField) and field.name == "lanes"):
             rows, headings = self.field_values(field, x, y, value)
@@ -490,19 +496,67 @@ class MapGeometry:
         if len(x):
             self._intersection_choice(x, y, lane)
         chosen = np.zeros(len(x))
+        off = np.flatnonzero(lane < 0)
+        if len(off):
+            chosen[off] = self._off_lanes(x[off], y[off])
         on = np.flatnonzero(lane >= 0)
         chosen[on] = road_map.centreline_polylines.direction_at(lane[on], x[on], y[on])
         return chosen
 
-    def _intersection_choice(self, x: np.ndarray, y: np.ndarray, lane: np.ndarray) -> None:
-        """Points in an intersection area take the first of its lanes containing them, else the
-        nearest (the first intersection area holding the point counts): set in ``lane``."""
+    @cached_property
+    def _shoulders(self) -> tuple[STRtree, Polylines] | None:
+        """An R-tree of the shoulders and their centrelines, when every shoulder has one (OpenDRIVE
+        maps): Scenic orients a shoulder along the nearest segment of its centreline."""
+        areas = self._require_map().shoulders
+        if not areas or any(a.centreline is None for a in areas):
+            return None
+        return STRtree(np.array([a.polygon for a in areas], dtype=object)), Polylines([a.centreline for a in areas])
+
+    def _off_lanes(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Scenic's road direction at points in no lane and no intersection area: the first shoulder
+        holding the point; else, within :data:`ELEMENT_REACH_M` (Scenic's second pass over its
+        elements, in its order), an intersection (its lane as inside one), the nearest lane
+        (standing for the lane of its road), the first shoulder; else 0 (radians)."""
+        road_map = self._require_map()
+        chosen = np.zeros(len(x))
+        points = shapely.points(x, y)
+        shoulders = self._shoulders
+        if shoulders is not None:
+            point, shoulder = _first_per_point(*shoulders[0].query(points, predicate="intersects"))
+            chosen[point] = shoulders[1].direction_at(shoulder, x[point], y[point])
+            rest = np.setdiff1d(np.arange(len(x)), point)
+        else:
+            rest = np.arange(len(x))
+        lane = np.full(len(rest), -1, dtype=np.intp)
+        if len(rest):
+            self._intersection_choice(x[rest], y[rest], lane, ELEMENT_REACH_M)
+        free = np.flatnonzero(lane < 0)
+        if len(free) and len(road_map.lanes):
+            nearest = road_map._lane_tree.nearest(points[rest[free]])
+            near = shapely.distance(road_map.lane_polygons[nearest], points[rest[free]]) <= ELEMENT_REACH_M
+            lane[free[near]] = nearest[near]
+        on = np.flatnonzero(lane >= 0)
+        chosen[rest[on]] = road_map.centreline_polylines.direction_at(lane[on], x[rest[on]], y[rest[on]])
+        free = rest[lane < 0]
+        if len(free) and shoulders is not None:
+            tree, lines = shoulders
+            point, shoulder = _first_per_point(*tree.query(points[free], predicate="dwithin", distance=ELEMENT_REACH_M))
+            chosen[free[point]] = lines.direction_at(shoulder, x[free[point]], y[free[point]])
+        return chosen
+
+    def _intersection_choice(self, x: np.ndarray, y: np.ndarray, lane: np.ndarray, reach: float = 0.0) -> None:
+        """Points in an intersection area (or within ``reach`` metres of one) take the first of its
+        lanes containing them, else the nearest (the first such intersection area counts): set in
+        ``lane``."""
         road_map = self._require_map()
         tree, flat, starts = self._intersection_areas
         if not len(flat):
             return
         points = shapely.points(x, y)
-        point, area = tree.query(points, predicate="intersects")
+        if reach > 0:
+            point, area = tree.query(points, predicate="dwithin", distance=reach)
+        else:
+            point, area = tree.query(points, predicate="intersects")
         point, area = _first_per_point(point, area)
         counts = starts[area + 1] - starts[area]
         group = np.repeat(np.arange(len(point)), counts)
@@ -600,7 +654,8 @@ def _first_per_point(point: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, n
 
 def _off_lane(road_map: RoadMap, x, y, missing, rows, headings) -> tuple[np.ndarray, np.ndarray]:
     """Road directions at points in no lane: Scenic's default 0 (outside every road element) and the
-    nearest lane's direction (standing in for a road or shoulder element's own orientation)."""
+    nearest lane's direction (standing in for a road element's own orientation); the caller adds
+    Scenic's own pick (a shoulder's direction)."""
     extra_rows = [missing]
     extra = [np.zeros(len(missing))]
     if len(road_map.lanes):

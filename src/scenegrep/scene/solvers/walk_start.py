@@ -12,10 +12,9 @@ end heading meets the heading bounds holds the solutions: its interior point (s,
 witness, walked again with Scenic's rule (:func:`~..follow.walk_end`) and checked against the
 row's whole system (:func:`.pointwise.satisfies`, requirements included) before it is reported.
 
-The row is undecided (the caller falls back to the general solvers) when the enumeration is not
-exact there (:class:`~..follow_regions.Unsure`: folded centrelines competing inside a region, a
-walk point near a shoulder, whose direction the map model does not hold) or when no candidate
-witness passes the check.
+The row is undecided (the caller falls back to the general solvers) when no candidate witness
+passes the check (a region through which folded centreline segments compete may take either
+segment's heading, so its interior point may walk otherwise: see :mod:`..follow_regions`).
 """
 
 from __future__ import annotations
@@ -27,7 +26,7 @@ import numpy as np
 import shapely
 
 from ..follow import MAX_STEPS, STEP_M, walk_end
-from ..follow_regions import StartRegion, Unsure, start_regions
+from ..follow_regions import StartRegion, start_regions
 from ..geometry import MapGeometry
 from ..regions import MapRegion
 from ..terms import Term
@@ -36,9 +35,9 @@ from .pointwise import bound_violation, satisfies
 from .problem import PointUnknown, Problem
 from .walk import ROAD_DIRECTION, _follow_terms
 
-SCENIC_TOLERANCE_M = 0.05
-"""Scenic's road network finds an element within this distance of a point when none holds it
-(``Network.tolerance`` of OpenDRIVE maps): walk points this near a shoulder are avoided."""
+
+GRID = 4
+"""Points per side of the grid of further candidate witnesses in a region."""
 
 
 @dataclass(frozen=True)
@@ -96,14 +95,7 @@ def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> 
             shapely.linestrings(np.stack([curbs.start, curbs.end], axis=1)), shapely.box(x0, y0, x1, y1), reach + 1e-9
         )
     )
-    shoulders = [a.polygon for a in road_map.shoulders]
-    avoid = shapely.buffer(shapely.union_all(shoulders), SCENIC_TOLERANCE_M) if shoulders else None
-    try:
-        regions = start_regions(
-            geometry, ROAD_DIRECTION, curbs.start[near], curbs.end[near], walk.lo, walk.hi, walk.box, avoid
-        )
-    except Unsure:
-        return Outcome("undecided", None, "follow-start")
+    regions = start_regions(geometry, ROAD_DIRECTION, curbs.start[near], curbs.end[near], walk.lo, walk.hi, walk.box)
     headings = [b for b in problem.bounds if _is_end_heading(b.term, walk.ends)]
     candidates = [r for r in regions if all(bound_violation(r.heading, b) == 0 for b in headings)]
     for region in candidates:
@@ -117,10 +109,15 @@ def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> 
 def _checked_witness(
     problem: Problem, walk: CurbWalk, geometry: MapGeometry, a: np.ndarray, b: np.ndarray, region: StartRegion
 ) -> dict[Term, float] | None:
-    """The region's interior point (or centroid) as an assignment, when Scenic's walk from it
-    meets the row's whole system; else None."""
+    """The first of the region's interior point, centroid and points of a grid over it (in
+    (s, D)) that, walked again with Scenic's rule, meets the row's whole system, as an assignment;
+    else None."""
     direction = (b - a) / np.hypot(*(b - a))
-    for point in (shapely.point_on_surface(region.shape), shapely.centroid(region.shape)):
+    s0, d0, s1, d1 = region.shape.bounds
+    grid = np.stack(np.meshgrid(np.linspace(s0, s1, GRID + 2)[1:-1], np.linspace(d0, d1, GRID + 2)[1:-1]), -1)
+    inside = shapely.points(grid.reshape(-1, 2))
+    inside = inside[shapely.contains(region.shape, inside)]
+    for point in [shapely.point_on_surface(region.shape), shapely.centroid(region.shape), *inside]:
         s, d = shapely.get_x(point), shapely.get_y(point)
         x, y = a + s * direction
         end_x, end_y = walk_end(geometry, ROAD_DIRECTION, [x], [y], [d], None)

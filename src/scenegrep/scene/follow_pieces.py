@@ -77,7 +77,8 @@ class Linework:
     """Where ``roadDirection`` may change (see the module docstring): segments with an R-tree, and
     pairs of non-adjacent centreline segments of one lane that may compete for a point, with an
     R-tree of the boxes where they may (within the lane's reach of both); the centreline segments
-    as lines."""
+    as lines; an R-tree of where a lane's direction may count at all (each lane grown by Scenic's
+    tolerance, and the intersection areas, where the nearest lane may count)."""
 
     start: np.ndarray
     end: np.ndarray
@@ -88,6 +89,7 @@ class Linework:
     pair_tree: shapely.STRtree
     polylines: Polylines
     segments: np.ndarray
+    lane_reach: shapely.STRtree
 
 
 class _Columns:
@@ -149,7 +151,8 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     pairs, lanes, boxes = _competing_pairs(polylines, reach)
     near = reach[lanes] + REACH_MARGIN_M
     segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
-    return Linework(start, end, tree, pairs, lanes, near, shapely.STRtree(boxes), polylines, segments)
+    lane_reach = shapely.STRtree(np.append(shapely.buffer(road_map.lane_polygons, ELEMENT_REACH_M), intersections))
+    return Linework(start, end, tree, pairs, lanes, near, shapely.STRtree(boxes), polylines, segments, lane_reach)
 
 
 def _competing_pairs(polylines: Polylines, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

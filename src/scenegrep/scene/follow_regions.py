@@ -33,6 +33,7 @@ read at the face's interior point, the assumption :mod:`.follow_pieces` makes pe
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -80,15 +81,15 @@ def start_regions(
     lo: float,
     hi: float,
     target: tuple[float, float, float, float],
-) -> list[StartRegion]:
+) -> Iterator[StartRegion]:
     """The final regions (see the module docstring) of the walks from every point of the segments
     ``start[i]``-``end[i]`` (rows of x, y) for every D in [lo, hi] (metres, lo < hi) that end in the
-    box ``target`` (x_lo, x_hi, y_lo, y_hi)."""
+    box ``target`` (x_lo, x_hi, y_lo, y_hi), segment after segment in the given order, each
+    region as soon as it is found."""
     lw = linework(geometry)
     box = np.array([[target[0], target[2]], [target[1], target[2]], [target[0], target[3]], [target[1], target[3]]])
     project = box @ DIRECTIONS.T
     window = (project.min(axis=0), project.max(axis=0))
-    found: list[StartRegion] = []
     for index in range(len(start)):
         delta = np.asarray(end[index], dtype=float) - start[index]
         length = float(np.hypot(*delta))
@@ -109,8 +110,7 @@ def start_regions(
             for shape, c in branches:
                 shape = _clip(shape, *_reach(seg, c, 0.0, window))
                 for part, heading in _faces(lw, geometry, field, seg, c, shape, last=True):
-                    found.append(StartRegion(index, steps, c, heading, part))
-    return found
+                    yield StartRegion(index, steps, c, heading, part)
 
 
 def _distance_parts(lo: float, hi: float) -> list[tuple[int, float, float]]:
@@ -264,10 +264,17 @@ def _limit(low, high, f0, f1, lo, hi) -> tuple[np.ndarray, np.ndarray]:
 def _tie_headings(lw: Linework, seg: _Start, c: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(face index, heading) pairs: where two competing centreline segments become equally near
     along an edge of a face's image, the headings of both (the heading may change along a curve
-    through the face, so the face may take either)."""
+    through the face, so the face may take either). Only faces whose image comes where a lane's
+    direction may count are checked."""
+    hulls = shapely.convex_hull(
+        shapely.multipoints(_image(seg, c, shapely.get_coordinates(faces)), indices=_owners(faces))
+    )
+    on_lanes = np.unique(lw.lane_reach.query(hulls, predicate="intersects")[0])
+    if not len(on_lanes):
+        return np.zeros(0, dtype=np.intp), np.zeros(0)
     coords, owner = shapely.get_coordinates(shapely.get_rings(faces), return_index=True)
     ring_face = np.repeat(np.arange(len(faces)), shapely.get_num_interior_rings(faces) + 1)
-    same = owner[1:] == owner[:-1]
+    same = (owner[1:] == owner[:-1]) & np.isin(ring_face[owner[:-1]], on_lanes)
     edges = np.concatenate([coords[:-1][same], coords[1:][same]], axis=1)
     face = ring_face[owner[:-1][same]]
     # an edge two faces share is checked once (either direction)
@@ -280,6 +287,11 @@ def _tie_headings(lw: Linework, seg: _Start, c: np.ndarray, faces: np.ndarray) -
     which = {e: segment[edge == e] for e in np.unique(edge).tolist()}
     rows = [(f, h) for f, e in zip(face[hit].tolist(), back.ravel()[hit].tolist()) for h in which[e].tolist()]
     return np.array([r[0] for r in rows], dtype=np.intp), lw.polylines.heading[np.array([r[1] for r in rows])]
+
+
+def _owners(geometries: np.ndarray) -> np.ndarray:
+    """For each coordinate of the geometries (shapely's order), the index of its geometry."""
+    return np.repeat(np.arange(len(geometries)), shapely.get_num_coordinates(geometries))
 
 
 def _no_terms(term):

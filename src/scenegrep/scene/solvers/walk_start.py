@@ -7,7 +7,10 @@ every ``follow`` term walks from that point for D over the lanes field, and ever
 the walk's end (its x, its y, its heading: the road direction there), the end boxed in x and y.
 Only curb segments within max |D| of the end's box can start a walk ending there (a walk of n
 steps of |D| / n metres); for each, :func:`~..follow_regions.start_regions` gives every (s, D)
-whose walk ends in the box, grouped by heading sequence and end heading, exactly. A region whose
+whose walk ends in the box, grouped by heading sequence and end heading, exactly. Segments, cut
+into pieces of at most 2 m, go first whose walks would come nearest to the box if they kept their
+first heading (roads are mostly straight), and the enumeration stops at the first witness that
+passes the check below: a match costs the pieces before it, a refutation all of them. A region whose
 end heading meets the heading bounds holds the solutions: its interior point (s, D) is the
 witness, walked again with Scenic's rule (:func:`~..follow.walk_end`) and checked against the
 row's whole system (:func:`.pointwise.satisfies`, requirements included) before it is reported.
@@ -38,6 +41,10 @@ from .walk import ROAD_DIRECTION, _follow_terms
 
 GRID = 4
 """Points per side of the grid of further candidate witnesses in a region."""
+
+PIECE_M = 2.0
+"""Curb segments are enumerated in pieces at most this long (metres), the likeliest first, so that
+a match is found without enumerating a long segment whole."""
 
 
 @dataclass(frozen=True)
@@ -95,15 +102,47 @@ def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> 
             shapely.linestrings(np.stack([curbs.start, curbs.end], axis=1)), shapely.box(x0, y0, x1, y1), reach + 1e-9
         )
     )
-    regions = start_regions(geometry, ROAD_DIRECTION, curbs.start[near], curbs.end[near], walk.lo, walk.hi, walk.box)
+    start, end = _pieces(curbs.start[near], curbs.end[near])
+    order = np.argsort(_straight_miss(geometry, start, end, walk), kind="stable")
+    start, end = start[order], end[order]
+    regions = start_regions(geometry, ROAD_DIRECTION, start, end, walk.lo, walk.hi, walk.box)
     headings = [b for b in problem.bounds if _is_end_heading(b.term, walk.ends)]
-    candidates = [r for r in regions if all(bound_violation(r.heading, b) == 0 for b in headings)]
-    for region in candidates:
-        segment = near[region.segment]
-        witness = _checked_witness(problem, walk, geometry, curbs.start[segment], curbs.end[segment], region)
+    candidates = 0
+    for region in regions:
+        if any(bound_violation(region.heading, b) > 0 for b in headings):
+            continue
+        candidates += 1
+        segment = region.segment
+        witness = _checked_witness(problem, walk, geometry, start[segment], end[segment], region)
         if witness is not None:
             return Outcome("sat", witness, "follow-start")
     return Outcome("undecided" if candidates else "unsat", None, "follow-start")
+
+
+def _pieces(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The segments cut into equal pieces at most :data:`PIECE_M` long (rows of x, y; metres)."""
+    count = np.maximum(1, np.ceil(np.hypot(*(end - start).T) / PIECE_M)).astype(np.intp)
+    owner = np.repeat(np.arange(len(start)), count)
+    k = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    step = (end - start)[owner] / count[owner, None]
+    return start[owner] + k[:, None] * step, start[owner] + (k[:, None] + 1) * step
+
+
+def _straight_miss(geometry: MapGeometry, start: np.ndarray, end: np.ndarray, walk: CurbWalk) -> np.ndarray:
+    """For each segment, how near to the end's box a walk from its ends or middle comes if it kept
+    its first heading (metres): a cheap guess at where the walks that match start."""
+    x0, x1, y0, y1 = walk.box
+    target = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
+    points = np.concatenate([start, (start + end) / 2, end])
+    heading = geometry.scenic_headings(ROAD_DIRECTION, points[:, 0], points[:, 1], _no_terms)
+    u = np.stack([-np.sin(heading), np.cos(heading)], axis=1)
+    along = np.clip(np.einsum("ij,ij->i", target - points, u), walk.lo, walk.hi)
+    miss = np.hypot(*(points + along[:, None] * u - target).T)
+    return miss.reshape(3, -1).min(axis=0)
+
+
+def _no_terms(term):
+    raise ValueError(f"roadDirection has no parameters, got {term!r}")
 
 
 def _checked_witness(

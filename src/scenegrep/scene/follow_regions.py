@@ -81,11 +81,13 @@ def start_regions(
     lo: float,
     hi: float,
     target: tuple[float, float, float, float],
+    hints: np.ndarray | None = None,
 ) -> Iterator[StartRegion]:
     """The final regions (see the module docstring) of the walks from every point of the segments
     ``start[i]``-``end[i]`` (rows of x, y) for every D in [lo, hi] (metres, lo < hi) that end in the
     box ``target`` (x_lo, x_hi, y_lo, y_hi), segment after segment in the given order, each
-    region as soon as it is found."""
+    region as soon as it is found. Within a segment the branches go depth first, the one nearest
+    to its hint (a row of s, D: where a match is likely) first."""
     lw = linework(geometry)
     box = np.array([[target[0], target[2]], [target[1], target[2]], [target[0], target[3]], [target[1], target[3]]])
     project = box @ DIRECTIONS.T
@@ -96,21 +98,27 @@ def start_regions(
         if length == 0:
             continue
         seg = _Start(index, np.asarray(start[index], dtype=float), delta / length)
-        for steps, d0, d1 in _distance_parts(lo, hi):
-            region = shapely.box(0.0, d0, length, d1)
-            sign = 1.0 if d0 >= 0 else -1.0
-            branches = [(region, np.zeros(2))]
-            for k in range(steps):
-                moved = []
-                for shape, c in branches:
-                    shape = _clip(shape, *_reach(seg, c, sign * (steps - k) / steps, window))
-                    for part, heading in _faces(lw, geometry, field, seg, c, shape, last=False):
-                        moved.append((part, c + np.array([-np.sin(heading), np.cos(heading)]) / steps))
-                branches = moved
-            for shape, c in branches:
-                shape = _clip(shape, *_reach(seg, c, 0.0, window))
-                for part, heading in _faces(lw, geometry, field, seg, c, shape, last=True):
-                    yield StartRegion(index, steps, c, heading, part)
+        hint = shapely.Point(hints[index]) if hints is not None else None
+        parts = [(shapely.box(0.0, d0, length, d1), np.zeros(2), 0, steps) for steps, d0, d1 in _distance_parts(lo, hi)]
+        stack = _nearest_last(parts, hint)
+        while stack:
+            shape, c, k, steps = stack.pop()
+            sign = 1.0 if shape.bounds[1] >= 0 else -1.0
+            shape = _clip(shape, *_reach(seg, c, sign * (steps - k) / steps, window))
+            faces = _faces(lw, geometry, field, seg, c, shape, last=k == steps)
+            if k == steps:
+                yield from (StartRegion(index, steps, c, heading, part) for part, heading in faces)
+                continue
+            moved = [(part, c + np.array([-np.sin(h), np.cos(h)]) / steps, k + 1, steps) for part, h in faces]
+            stack.extend(_nearest_last(moved, hint))
+
+
+def _nearest_last(branches: list, hint: shapely.Point | None) -> list:
+    """The branches ordered so that the one nearest to the hint comes last (popped first)."""
+    if hint is None or len(branches) < 2:
+        return branches
+    distance = shapely.distance(np.array([b[0] for b in branches], dtype=object), hint)
+    return [branches[i] for i in np.argsort(-distance, kind="stable")]
 
 
 def _distance_parts(lo: float, hi: float) -> list[tuple[int, float, float]]:

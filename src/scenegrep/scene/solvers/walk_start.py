@@ -8,9 +8,10 @@ the walk's end (its x, its y, its heading: the road direction there), the end bo
 Only curb segments within max |D| of the end's box can start a walk ending there (a walk of n
 steps of |D| / n metres); for each, :func:`~..follow_regions.start_regions` gives every (s, D)
 whose walk ends in the box, grouped by heading sequence and end heading, exactly. Segments, cut
-into pieces of at most 2 m, go first whose walks would come nearest to the box if they kept their
-first heading (roads are mostly straight), and the enumeration stops at the first witness that
-passes the check below: a match costs the pieces before it, a refutation all of them. A region whose
+into pieces of at most 2 m, go first whose walks from a few sampled points and distances end
+nearest to the box (within a piece, the branch nearest to that sample first), and the
+enumeration stops at the first witness that passes the check below: a match costs the pieces
+before it, a refutation all of them. A region whose
 end heading meets the heading bounds holds the solutions: its interior point (s, D) is the
 witness, walked again with Scenic's rule (:func:`~..follow.walk_end`) and checked against the
 row's whole system (:func:`.pointwise.satisfies`, requirements included) before it is reported.
@@ -41,6 +42,9 @@ from .walk import ROAD_DIRECTION, _follow_terms
 
 GRID = 4
 """Points per side of the grid of further candidate witnesses in a region."""
+
+SAMPLES = 3
+"""Points per piece, and distances, of the walks that order the pieces."""
 
 PIECE_M = 2.0
 """Curb segments are enumerated in pieces at most this long (metres), the likeliest first, so that
@@ -103,9 +107,10 @@ def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> 
         )
     )
     start, end = _pieces(curbs.start[near], curbs.end[near])
-    order = np.argsort(_straight_miss(geometry, start, end, walk), kind="stable")
-    start, end = start[order], end[order]
-    regions = start_regions(geometry, ROAD_DIRECTION, start, end, walk.lo, walk.hi, walk.box)
+    miss, hints = _sampled_miss(geometry, start, end, walk)
+    order = np.argsort(miss, kind="stable")
+    start, end, hints = start[order], end[order], hints[order]
+    regions = start_regions(geometry, ROAD_DIRECTION, start, end, walk.lo, walk.hi, walk.box, hints)
     headings = [b for b in problem.bounds if _is_end_heading(b.term, walk.ends)]
     candidates = 0
     for region in regions:
@@ -128,17 +133,23 @@ def _pieces(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     return start[owner] + k[:, None] * step, start[owner] + (k[:, None] + 1) * step
 
 
-def _straight_miss(geometry: MapGeometry, start: np.ndarray, end: np.ndarray, walk: CurbWalk) -> np.ndarray:
-    """For each segment, how near to the end's box a walk from its ends or middle comes if it kept
-    its first heading (metres): a cheap guess at where the walks that match start."""
+def _sampled_miss(
+    geometry: MapGeometry, start: np.ndarray, end: np.ndarray, walk: CurbWalk
+) -> tuple[np.ndarray, np.ndarray]:
+    """For each piece, how near to the end's box Scenic's walk from a few of its points for a few
+    distances of the range comes (metres), and the (s, D) of the nearest: a cheap guess at where
+    the walks that match start."""
     x0, x1, y0, y1 = walk.box
-    target = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
-    points = np.concatenate([start, (start + end) / 2, end])
-    heading = geometry.scenic_headings(ROAD_DIRECTION, points[:, 0], points[:, 1], _no_terms)
-    u = np.stack([-np.sin(heading), np.cos(heading)], axis=1)
-    along = np.clip(np.einsum("ij,ij->i", target - points, u), walk.lo, walk.hi)
-    miss = np.hypot(*(points + along[:, None] * u - target).T)
-    return miss.reshape(3, -1).min(axis=0)
+    where = np.linspace(0.0, 1.0, SAMPLES)
+    points = (start[:, None, :] + where[None, :, None] * (end - start)[:, None, :]).reshape(-1, 2)
+    distances = np.linspace(walk.lo, walk.hi, SAMPLES)
+    x, y = np.repeat(points[:, 0], SAMPLES), np.repeat(points[:, 1], SAMPLES)
+    end_x, end_y = walk_end(geometry, ROAD_DIRECTION, x, y, np.tile(distances, len(points)), _no_terms)
+    miss = np.hypot(end_x - (x0 + x1) / 2, end_y - (y0 + y1) / 2).reshape(len(start), -1)
+    best = np.argmin(miss, axis=1)
+    length = np.hypot(*(end - start).T)
+    hints = np.stack([where[best // SAMPLES] * length, distances[best % SAMPLES]], axis=1)
+    return miss.min(axis=1), hints
 
 
 def _no_terms(term):

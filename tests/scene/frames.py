@@ -8,8 +8,10 @@ unknown when not given); the object named
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
+import pyarrow.feather as feather
 
 from scenegrep.model import LabelTrace, ObjectTable, StateTable
 from scenegrep.model.layers import UnknownLayers
@@ -59,3 +61,14 @@ def ahead(x: float, y: float, heading: float, distance: float) -> tuple[float, f
 def right(x: float, y: float, heading: float, distance: float) -> tuple[float, float]:
     """The point ``distance`` metres to the right of (x, y) for a Scenic heading."""
     return x + distance * math.cos(heading), y + distance * math.sin(heading)
+
+
+def av2_ego_velocity(log: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Times (s) and the ego's velocity (vx, vy in m/s, city frame) at each annotation timestamp of
+    an AV2 sensor log: central differences of its city positions (one-sided at the ends), read
+    from the log's feather files, not through scenegrep."""
+    stamps = np.unique(feather.read_table(log / "annotations.feather", columns=["timestamp_ns"])["timestamp_ns"])
+    poses = feather.read_table(log / "city_SE3_egovehicle.feather").to_pandas().set_index("timestamp_ns")
+    t = (stamps - stamps[0]) / 1e9
+    x, y = poses.tx_m.loc[stamps].to_numpy(), poses.ty_m.loc[stamps].to_numpy()
+    return t, np.gradient(x, t), np.gradient(y, t)

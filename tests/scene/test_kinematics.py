@@ -33,7 +33,7 @@ from scenegrep.scene import SceneOptions, compile_scene
 from scenegrep.scene.evaluate import Evaluator, Rows
 from scenegrep.scene.geometry import geometry_of
 from scenegrep.scene.match import labels_of
-from tests.scene.frames import HEADER, MAP, matches, trace_of
+from tests.scene.frames import HEADER, MAP, av2_ego_velocity, matches, trace_of
 
 MAX_GAP_S = 1.0
 """Neighbouring states of a track farther apart than this (s) are not differenced (the engine's rule)."""
@@ -356,15 +356,17 @@ def test_relative_speed_on_a_real_recording(recording):
     assert query.match(trace, None, options).frames().tolist() == expected.tolist()
 
 
-def test_accelerations_from_estimated_velocities_are_unknown():
-    """AV2 sensor logs record no velocities: the accelerations, their differences, are unknown too."""
+def test_accelerations_from_estimated_velocities_are_their_differences():
+    """AV2 sensor logs record no velocities: the accelerations are the central differences of the
+    velocities the reader estimated from positions (here recomputed from the raw ego poses)."""
     log = AV2.parents[1] / "sensor" / "7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
     if not log.exists():
         pytest.skip("../shared/real_data is not here")
-    query = compile_scene(HEADER + BRAKING_EGO + "require ego.acceleration.y > 1\n", "accelerating.scenic")
-    with pytest.raises(UserError) as caught:
-        query.match(read_sensor_log(log), None, SceneOptions())
-    assert caught.value.one_line() == (
-        f"{log}: ego.acceleration is unknown: trace '{log.name}' has no acceleration for object 'ego' at frame 0"
-        " (the data records none; the reader's estimates from positions are not labels)"
-    )
+    t, vx, vy = av2_ego_velocity(log)
+    along = (np.gradient(vx, t) * vx + np.gradient(vy, t) * vy) / np.maximum(np.hypot(vx, vy), 1e-9)
+    expected = np.flatnonzero(along < -1.5)  # braking harder than 1.5 m/s² along the motion
+    assert 5 <= len(expected) < len(t) / 2
+    program = BRAKING_EGO + "require (ego.acceleration.x * ego.velocity.x + ego.acceleration.y * ego.velocity.y)"
+    program += " < -1.5 * max(ego.speed, 1e-9)\n"
+    query = compile_scene(HEADER + program, "braking.scenic")
+    assert query.match(read_sensor_log(log), None, SceneOptions()).frames().tolist() == expected.tolist()

@@ -444,13 +444,15 @@ def test_pedestrian_crossing_in_front_of_ego() -> None:
     """nuScenes scene-0553: 340ccb3c walks (1.2-1.7 m/s) across the standing ego's axis 8-9 m
     ahead, from 21 deg left to 21 deg right, over frames 83-129; Waymo motion_data 2320 from 21
     deg left to 23 deg right, 8-9 m ahead, over frames 27-74. Not crossing: scene-0061 73ee514c
-    walks beside the driving ego (44-161 deg off its heading over frames 85-121); scene-0061
-    6dd2cbf4 stands (under 0.2 m/s) while the ego's turn sweeps its axis past it."""
+    walks beside the driving ego (45-161 deg off its heading over frames 85-121); AV2 7fab2350
+    de40f64f passes from one side of the axis to the other 6-18 m ahead (frames 114-155), but
+    only as the ego drives toward it while it slows from 1.1 m/s to a stand on a crossing's edge:
+    not walking across (the only pedestrian whose geometry alone would pass)."""
     name = "pedestrian_crossing_in_front_of_ego"
     assert_positive(name, NUSC.format("0553"), "340ccb3c", 83, 129)
     assert_positive(name, WAYMO_ONE, "2320", 27, 74)
     assert_negative(name, NUSC.format("0061"), "73ee514c")
-    assert_negative(name, NUSC.format("0061"), "6dd2cbf4")
+    assert_negative(name, AV2_OTHER, "de40f64f")
 
 
 def test_pedestrian_crossing_between_bollards() -> None:

@@ -1,8 +1,8 @@
-# Finds: frames with a moving vehicle (over 1 m/s) whose centre is inside or within 5 m of an intersection (RefAV "near intersection")
+# Finds: frames with a moving vehicle (over 1 m/s) other than the ego whose centre is inside or within 5 m of an intersection (RefAV "near intersection")
 # Run: scene unknown_layers=permissive
-# A scene query: one correspondence per matching frame (scenegrep scene reports the first it
-# finds), so it answers which frames have such a vehicle; the free roadDeviation and
-# regionContainedIn admit vehicles turning across or standing beside their lanes.
+# A scene query, frame by frame; it reports one such vehicle per frame. "in everywhere" and the free
+# roadDeviation and regionContainedIn admit vehicles off Scenic's road and across their lanes (a bus
+# swinging wide at a corner). The speed is the recording's, compared exactly.
 model scenic.simulators.newtonian.driving_model
 
 ego = new Car in everywhere, with roadDeviation Range(-180, 180) deg, with regionContainedIn everywhere

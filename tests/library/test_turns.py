@@ -369,9 +369,9 @@ def track(relative: str, prefix: str) -> Track:
     return found_track
 
 
-def answer(name: str, relative: str, prefix: str) -> list[tuple[int, int]]:
-    """The query's windows for the label object whose id starts with ``prefix``."""
-    return [w for key, windows in found(name, relative).items() if key.startswith(prefix) for w in windows]
+def answer(name: str, relative: str, object_id: str) -> list[tuple[int, int]]:
+    """The query's windows for one label object."""
+    return found(name, relative).get(object_id, [])
 
 
 def check_positive(name: str, relative: str, prefix: str, frames: tuple[int, int]) -> None:

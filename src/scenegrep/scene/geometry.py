@@ -361,15 +361,20 @@ class MapGeometry:
         if isinstance(region, (Everywhere, Nowhere)):
             return np.full(len(np.atleast_1d(x)), 0.0 if isinstance(region, Everywhere) else np.inf)
         if isinstance(region, MapRegion):
-            union = self._unions[region.layer]
-            return (
-                np.full(len(np.atleast_1d(x)), np.inf)
-                if union.is_empty
-                else shapely.distance(union, shapely.points(x, y))
-            )
+            return self._layer_distances(region.layer, x, y)
         if isinstance(region, Union) and all(isinstance(p, MapRegion) for p in region.parts):
             return np.min([self._distances(p, x, y) for p in region.parts], axis=0)
         raise UserError(f"the distance to {_describe(region)} is not supported")
+
+    def _layer_distances(self, layer: str, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Distance (m) from each point to a map layer: to its nearest element, found in the layer's
+        R-tree (the distance to the layer's union, without measuring against the whole union)."""
+        distances = np.full(len(np.atleast_1d(x)), np.inf)
+        if len(self._layer_parts[layer]):
+            points = shapely.points(np.atleast_1d(x), np.atleast_1d(y))
+            (rows, _), nearest = self._trees[layer].query_nearest(points, return_distance=True, all_matches=False)
+            distances[rows] = nearest
+        return distances
 
     def unoriented(self, field: Field) -> set[str]:
         """The layers (``sidewalk``, ``crossing``) whose elements' directions ``field`` reads and

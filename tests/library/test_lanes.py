@@ -54,6 +54,7 @@ LANKER = "commonroad_ngsim/USA_Lanker-1_1_T-1.xml"
 REACH_M = 30.0
 HALF_S = 2.0
 MIN_SIDEWAYS_M = 1.2
+ALONG_LANE_RAD = 0.5
 
 
 # ---------------------------------------------------------------- raw data
@@ -83,7 +84,7 @@ class Raw:
         self.egos = (
             [self.ids.index(self.ego)] if self.ego is not None else [k for k in self.vehicles if self.kinds[k] == "car"]
         )
-        self._reach: dict[int, frozenset[int]] = {}
+        self._reach: dict[tuple[int, int], frozenset[int]] = {}
 
     def _speeds(self) -> np.ndarray:
         """Central (one-sided at track ends) finite differences of the positions, m/s; NaN unobserved."""
@@ -102,21 +103,30 @@ class Raw:
         with np.errstate(invalid="ignore", divide="ignore"):
             return np.where(p & (dt > 0), np.hypot(dx, dy) / dt, np.nan)
 
-    def reach(self, lane: int) -> frozenset[int]:
-        """The lane and its successors up to 30 m past its end (lane indices)."""
-        if lane not in self._reach:
+    def reach(self, f: int, ego: int) -> frozenset[int]:
+        """The ego's lanes ahead at frame f: its lane, and the successors that start less than 30 m
+        along the lanes from the ego. Where a lane has several successors, or one in an
+        intersection, only those the ego itself drives later are its lane (the ego's own path
+        decides the branch, and a junction the ego does not cross is another road's)."""
+        key = (f, ego)
+        if key not in self._reach:
             index = self.map.lane_index
-            found, todo = {lane}, [(lane, 0.0)]
+            later = set(self.lane[f:, ego][self.present[f:, ego]].tolist())
+            start = int(self.lane[f, ego])
+            line = shapely.LineString(self.map.lanes[start].centreline)
+            left = line.length - line.project(shapely.Point(self.x[f, ego], self.y[f, ego]))
+            found, todo = {start}, [(start, left)]
             while todo:
                 current, travelled = todo.pop()
-                for successor in self.map.lanes[current].successors:
-                    k = index.get(successor)
-                    if k is None or k in found or travelled >= REACH_M:
+                successors = [index[s] for s in self.map.lanes[current].successors if s in index]
+                for k in successors:
+                    ours = k in later or (len(successors) == 1 and not self.map.lane_is_intersection[k])
+                    if k in found or travelled >= REACH_M or not ours:
                         continue
                     found.add(k)
                     todo.append((k, travelled + shapely.LineString(self.map.lanes[k].centreline).length))
-            self._reach[lane] = frozenset(found)
-        return self._reach[lane]
+            self._reach[key] = frozenset(found)
+        return self._reach[key]
 
     def side_neighbours(self, lane: int, side: str) -> set[str]:
         """Ids of the same-direction lanes on ``side`` of a lane, also through one successor or
@@ -144,15 +154,27 @@ class Raw:
         return -np.sin(h) * (self.x[f, other] - self.x[f, ref]) + np.cos(h) * (self.y[f, other] - self.y[f, ref])
 
     def in_lane_ahead(self, f: int, ego: int) -> dict[int, float]:
-        """Vehicles in the ego's lanes ahead at frame f, 0-30 m ahead of it: vehicle -> metres ahead."""
+        """Vehicles in the ego's lanes ahead at frame f (:meth:`reach`), facing along their lane
+        within 0.5 rad, ahead of the ego (along its heading) and at most 30 m from it: vehicle -> metres
+        ahead."""
         if not self.present[f, ego] or self.lane[f, ego] < 0:
             return {}
-        lanes = self.reach(int(self.lane[f, ego]))
-        others = np.array([k for k in self.vehicles if k != ego and self.present[f, k] and self.lane[f, k] in lanes])
+        lanes = self.reach(f, ego)
+        others = np.array(
+            [
+                k
+                for k in self.vehicles
+                if k != ego
+                and self.present[f, k]
+                and self.lane[f, k] in lanes
+                and abs(heading_difference(self.h[f, k], self.lane_dir[f, k])) < ALONG_LANE_RAD
+            ]
+        )
         if not len(others):
             return {}
         ahead = self.along(f, ego, others)
-        return {int(k): float(a) for k, a in zip(others, ahead) if 0 < a <= REACH_M}
+        distance = np.hypot(self.x[f, others] - self.x[f, ego], self.y[f, others] - self.y[f, ego])
+        return {int(k): float(a) for k, a, d in zip(others, ahead, distance) if 0 < a and d <= REACH_M}
 
 
 @cache
@@ -302,9 +324,20 @@ def passes(relative: str, ref: int, other: int, sides: tuple[str, ...], window: 
             if not beside[f2]:
                 break
             if ahead[f2] > 0:
-                starts.append(int(f1))
+                if fits(r.present[:, ref] & r.present[:, other], int(f1), f2, window):
+                    starts.append(int(f1))
                 break
     return starts
+
+
+def fits(observed: np.ndarray, first: int, last: int, window: int) -> bool:
+    """Whether frames first..last lie in a span of ``window`` frames throughout which ``observed``
+    holds: a fixed-length window query can only see what such a span holds (US101-3_3 lasts 32
+    frames, so no 4 s window fits in it)."""
+    return any(
+        observed[s : s + window].all() and s + window <= len(observed)
+        for s in range(max(0, last - window + 1), first + 1)
+    )
 
 
 def overtaking(relative: str, seconds: float = 4.0) -> dict[tuple[int, int], list[int]]:
@@ -337,7 +370,247 @@ def overtaken_on_right_while_followed(relative: str, seconds: float = 4.0) -> di
         for k in r.vehicles:
             if k in (e, lead):
                 continue
-            starts = [s for s in passes(relative, lead, k, ("right",), window, moving=False) if flags[s]]
+            starts = [
+                s
+                for s in passes(relative, lead, k, ("right",), window, moving=False)
+                if flags[s] and fits(flags & r.present[:, k], s, s + 1, window)
+            ]
             if starts:
                 out[(e, lead, k)] = starts
     return out
+
+
+# ---------------------------------------------------------------- helpers of the tests
+def vehicle_units() -> set[tuple[str, str]]:
+    """Every (recording, vehicle) of the 20 recordings: the unit of the object-level counts."""
+    return {(rel, raw(rel).ids[k]) for rel in catalog.RECORDINGS for k in raw(rel).vehicles}
+
+
+def predicted(name: str, program_object: str) -> set[tuple[str, str]]:
+    """(recording, label object) that ``program_object`` of query ``name`` matches somewhere."""
+    return {(rel, found) for rel in catalog.RECORDINGS for found in answers(name, rel).get(program_object, {})}
+
+
+def object_ids(pairs: dict, position: int, relative: str) -> set[tuple[str, str]]:
+    """(recording, id) of the objects at ``position`` of a truth's keys (tuples of object rows)."""
+    return {(relative, raw(relative).ids[key[position]]) for key in pairs}
+
+
+def frame_counts(name: str, truth) -> tuple[int, int, int, int]:
+    """Frame-level (TP, FP, FN, TN) of a scene query over the 20 recordings."""
+    total = np.zeros(4, dtype=int)
+    for rel in catalog.RECORDINGS:
+        total += confusion(set(truth(rel)), matched_frames(name, rel), set(range(raw(rel).n_frames)))
+    return tuple(int(v) for v in total)
+
+
+def overlaps(windows: list[tuple[int, int]], first: int, last: int) -> bool:
+    return any(a <= last and b >= first for a, b in windows)
+
+
+def change(relative: str, vehicle: str, side: str) -> tuple[int, float]:
+    """(frame, sideways metres) of the vehicle's lane change to ``side`` (the first one)."""
+    return next((f, m) for v, s, f, m in lane_changes(relative) if v == vehicle and s == side)
+
+
+# ---------------------------------------------------------------- 1. accelerating, changing lanes right
+ACCEL_RIGHT = "accelerating_vehicle_changing_lanes_right"
+
+
+def test_accelerating_right_lane_change_found_where_the_raw_data_has_one():
+    """nuScenes scene-1100: car 0ba56cee steps from an intersection lane into the lane right of
+    its continuation at frame 120, 3.1 m rightwards over the 2 s either side, and speeds up by
+    2.0 m/s over those 2 s (> RefAV's 0.65 m/s^2). The only such change in the 20 recordings."""
+    rel, car = NUSC.format("1100"), "0ba56cee062b419a80a6a90302944c19"
+    frame, moved = change(rel, car, "right")
+    assert frame == 120 and moved > 3.0 and speed_gain(rel, car, frame) > 2.0
+    assert set(accelerating_right_changes()) == {(rel, car)}
+    assert overlaps(answers(ACCEL_RIGHT, rel)["car"][car], frame - 10, frame + 10)
+
+
+def test_right_lane_changes_that_slow_down_are_not_accelerating():
+    """AV2 7fab2350: 373d3e69 changes right at frame 137 (3.5 m) losing 1.1 m/s; AV2 adcf7d18:
+    41269c43 changes right at frame 69 (4.8 m) losing 1.8 m/s: neither matches. CommonRoad
+    US101-3_3 has one lane change, to the left (394): no match at all."""
+    for rel, car in ((AV2_A, "373d3e69-efec-4d4f-9b01-8769fbc4812a"), (AV2_B, "41269c43-9935-4093-80af-98df27071e5c")):
+        frame, moved = change(rel, car, "right")
+        assert moved > 3.0 and speed_gain(rel, car, frame) < -1.0
+        assert car not in answers(ACCEL_RIGHT, rel).get("car", {})
+    assert {side for _, side, _, _ in lane_changes(US101_3)} == {"left"}
+    assert catalog.matches(ACCEL_RIGHT, US101_3) == []
+
+
+# ---------------------------------------------------------------- 2. changing lanes left
+LEFT = "vehicle_changing_lanes_left"
+
+
+@pytest.mark.parametrize(
+    "rel, car, frame",
+    [
+        (NUSC.format("1077"), "437fe13d66554c51b1ea89f940e5bf4b", 130),
+        (NUSC.format("1077"), "46b5bbeeb0b5461ea77c6a4a1e0ac6cb", 150),
+        (AV2_B, "defe1ad3-dbfb-46b1-9244-a9b7fb426d3d", 27),
+        (US101_3, "394", 18),
+    ],
+)
+def test_left_lane_changes_are_found(rel, car, frame):
+    """Each steps into its lane's left neighbour at ``frame`` (e.g. nuScenes 1077 437fe13d from
+    3f348925 to a0c8c2ae, 2.3 m leftwards over 4 s; US101-3_3 394, 2.0 m): the query names it in a
+    window within 2 s of the step."""
+    found, moved = change(rel, car, "left")
+    assert found == frame and moved >= MIN_SIDEWAYS_M
+    assert overlaps(answers(LEFT, rel)["car"][car], frame - 20, frame + 20)
+
+
+def test_no_left_lane_change_no_answer():
+    """nuScenes scene-0103 and scene-0757 have no lane change at all in the raw data, and no
+    answer; AV2 7fab2350's 373d3e69 changes to the right (frame 137), and is not an answer."""
+    for rel in (NUSC.format("0103"), NUSC.format("0757")):
+        assert lane_changes(rel) == [] and catalog.matches(LEFT, rel) == []
+    assert change(AV2_A, "373d3e69-efec-4d4f-9b01-8769fbc4812a", "right")[1] > 3.0
+    assert "373d3e69-efec-4d4f-9b01-8769fbc4812a" not in answers(LEFT, AV2_A)["car"]
+
+
+# ---------------------------------------------------------------- 3. same lane, ahead
+AHEAD = "vehicle_in_same_lane_ahead_of_ego"
+
+
+def test_vehicle_ahead_in_lane_found():
+    """nuScenes scene-1077: car ed634e83 is in the ego's lanes ahead (at most 30 m) in 200 of the
+    201 frames; Waymo ScenarioNet: vehicle 2 is ahead of the ego (51) in 196 of 199 frames; AV2
+    adcf7d18: f5e7cc26 is ahead of the ego. The query answers at least 183 of those frames."""
+    for rel, car in ((NUSC.format("1077"), "ed634e83a0664c59b8d5e7cc84f8ae3e"), (WAYMO_SD, "2")):
+        r = raw(rel)
+        frames = {f for f, pairs in lane_ahead_frames(rel).items() if any(r.ids[k] == car for _, k in pairs)}
+        assert len(frames) >= 196
+        found = {row["start_frame"] for row in catalog.matches(AHEAD, rel)}
+        assert len(frames & found) >= 183
+        assert car in answers(AHEAD, rel)["car"]
+    r = raw(AV2_B)
+    car = "f5e7cc26-f036-4128-995a-3c804c6b2ead"
+    assert any(r.ids[k] == car for pairs in lane_ahead_frames(AV2_B).values() for _, k in pairs)
+    assert car in answers(AHEAD, AV2_B)["car"]
+
+
+def test_no_vehicle_ahead_in_lane_no_answer():
+    """nuScenes scene-0553 and scene-0916 and AV2 7fab2350: no vehicle is ever in the ego's lanes
+    ahead within 30 m (raw lanes), and the query answers no frame."""
+    for rel in (NUSC.format("0553"), NUSC.format("0916"), AV2_A):
+        assert lane_ahead_frames(rel) == {}
+        assert catalog.matches(AHEAD, rel) == []
+
+
+# ---------------------------------------------------------------- 4. following
+FOLLOW = "ego_following_vehicle"
+
+
+@pytest.mark.parametrize(
+    "rel, lead",
+    [
+        (NUSC.format("1077"), "ed634e83a0664c59b8d5e7cc84f8ae3e"),
+        (NUSC.format("1094"), "3f81e988f45c44119cca8011a3274603"),
+        (NUSC.format("0061"), "c1958768d48640948f6053d04cffd35b"),
+        (WAYMO_SD, "2"),
+    ],
+)
+def test_following_found(rel, lead):
+    """The ego drives behind ``lead`` in its lanes, both faster than 1 m/s, for 3 s windows starting
+    at frames 0-140 (nuScenes 1077), 60-164 (1094), 24-157 (0061) and 113-157 (Waymo): the query
+    matches windows starting among them."""
+    r = raw(rel)
+    truth = following(rel)
+    starts = next(s for (e, k), s in truth.items() if r.ids[k] == lead and r.ids[e] == r.ego)
+    windows = answers(FOLLOW, rel)["lead"][lead]
+    assert {a for a, _ in windows} & set(starts)
+
+
+def test_following_not_found_without_a_lead():
+    """nuScenes scene-0553, scene-0796 and scene-0916: no vehicle in the ego's lanes ahead for 3 s
+    while both move; no answer."""
+    for rel in (NUSC.format("0553"), NUSC.format("0796"), NUSC.format("0916")):
+        assert following(rel) == {}
+        assert catalog.matches(FOLLOW, rel) == []
+
+
+# ---------------------------------------------------------------- 5. two vehicles ahead
+TWO = "two_vehicles_ahead_of_ego"
+
+
+def test_two_vehicles_ahead_found():
+    """AV2 adcf7d18: f5e7cc26 is in the ego's lanes ahead and 1dcc1175 in f5e7cc26's (frames 0-102);
+    CommonRoad US101-4_1 (a queue on the highway): in every frame some car has two ahead."""
+    r = raw(AV2_B)
+    first, second = (
+        r.ids.index("f5e7cc26-f036-4128-995a-3c804c6b2ead"),
+        r.ids.index("1dcc1175-d4ae-4b85-ac19-4619924052b9"),
+    )
+    ego = r.egos[0]
+    chained = {f for f in range(50) if first in r.in_lane_ahead(f, ego) and second in r.in_lane_ahead(f, first)}
+    assert len(chained) >= 45
+    rows = {row["start_frame"]: json.loads(row["correspondence"]) for row in catalog.matches(TWO, AV2_B)}
+    assert {f for f in chained if rows.get(f, {}).get("second") == r.ids[second]} >= chained - {0, 1, 2}
+    assert two_ahead_frames(US101_4) == set(range(raw(US101_4).n_frames))
+    assert matched_frames(TWO, US101_4) == set(range(raw(US101_4).n_frames))
+
+
+def test_one_vehicle_ahead_is_not_two():
+    """nuScenes scene-1077 and scene-1094: one vehicle is ahead in the ego's lanes for most of the
+    scene (ed634e83, 3f81e988), never a second one ahead of it; the query answers no frame."""
+    for rel in (NUSC.format("1077"), NUSC.format("1094")):
+        assert len(lane_ahead_frames(rel)) > 150 and two_ahead_frames(rel) == set()
+        assert catalog.matches(TWO, rel) == []
+
+
+# ---------------------------------------------------------------- 6. overtaking the ego
+OVERTAKE = "vehicle_overtaking_ego"
+
+
+def test_overtaking_found():
+    """nuScenes scene-0796: car 69385845, in a lane beside the moving ego's, is behind it at frames
+    119-157 and ahead within 4 s; CommonRoad US101-4_1: car 405 passes car 401 (frames 23-55)."""
+    rel = NUSC.format("0796")
+    r = raw(rel)
+    starts = next(s for (e, k), s in overtaking(rel).items() if r.ids[k].startswith("69385845"))
+    assert starts[0] == 119
+    windows = answers(OVERTAKE, rel)["car"]["69385845cb9747b7afe095177cc405b5"]
+    assert {a for a, _ in windows} & set(starts)
+    r = raw(US101_4)
+    assert (r.ids.index("401"), r.ids.index("405")) in overtaking(US101_4)
+    assert "405" in answers(OVERTAKE, US101_4)["car"]
+
+
+def test_no_overtaking_while_following():
+    """nuScenes scene-1077 and scene-1094: the ego follows a lead and no vehicle passes it in a lane
+    beside; no answer."""
+    for rel in (NUSC.format("1077"), NUSC.format("1094")):
+        assert overtaking(rel) == {}
+        assert catalog.matches(OVERTAKE, rel) == []
+
+
+# ---------------------------------------------------------------- 7. followed by the ego, overtaken on the right
+RIGHT = "vehicle_followed_by_ego_overtaken_on_right"
+
+
+def test_overtaken_on_right_found_only_where_any_car_is_the_ego():
+    """No recording with an ego (AV2, nuScenes, Waymo) has the situation in its raw data. CommonRoad
+    US101-4_1, any car being the ego: car 475 follows 468 while 405 passes 468 in the lane to its
+    right (from frame 2), and 451 follows 442 while 399 passes it (from frame 8)."""
+    for rel in catalog.RECORDINGS:
+        if raw(rel).ego is not None:
+            assert overtaken_on_right_while_followed(rel) == {}, rel
+    r = raw(US101_4)
+    truth = overtaken_on_right_while_followed(US101_4)
+    for ego, lead, passer in (("475", "468", "405"), ("451", "442", "399")):
+        assert (r.ids.index(ego), r.ids.index(lead), r.ids.index(passer)) in truth
+        assert any(
+            json.loads(row["correspondence"]) == {"ego": ego, "lead": lead, "passer": passer}
+            for row in catalog.matches(RIGHT, US101_4)
+        )
+
+
+def test_followed_but_not_overtaken_on_right():
+    """nuScenes scene-1077 and scene-1094: the ego follows a lead (raw lanes), nobody passes the lead
+    on its right; no answer."""
+    for rel in (NUSC.format("1077"), NUSC.format("1094")):
+        assert following(rel) and overtaken_on_right_while_followed(rel) == {}
+        assert catalog.matches(RIGHT, rel) == []

@@ -182,6 +182,7 @@ def raw(relative: str) -> Raw:
     return Raw(relative)
 
 
+@cache
 def lane_changes(relative: str) -> list[tuple[str, str, int, float]]:
     """(vehicle id, side, frame of the lane step, sideways metres over the 2 s either side)."""
     r = raw(relative)
@@ -253,6 +254,7 @@ def speed_gain(relative: str, vehicle: str, frame: int, half: int = 10) -> float
     return float(r.speed[later, k] - r.speed[earlier, k])
 
 
+@cache
 def accelerating_right_changes() -> dict[tuple[str, str], float]:
     """(recording, vehicle) -> speed gain over the 2 s around a right lane change, for the changes
     that gain at least 1.3 m/s: RefAV's 0.65 m/s^2 sustained over the 2 s."""
@@ -265,6 +267,7 @@ def accelerating_right_changes() -> dict[tuple[str, str], float]:
     return out
 
 
+@cache
 def lane_ahead_frames(relative: str) -> dict[int, dict[tuple[int, int], float]]:
     """Per frame: (ego, vehicle) -> metres ahead, for vehicles in the ego's lanes 0-30 m ahead."""
     r = raw(relative)
@@ -276,6 +279,7 @@ def lane_ahead_frames(relative: str) -> dict[int, dict[tuple[int, int], float]]:
     return out
 
 
+@cache
 def two_ahead_frames(relative: str) -> set[int]:
     """Frames where some vehicle is in the ego's lanes 0-30 m ahead and another in that vehicle's
     lanes 0-30 m ahead of it."""
@@ -293,6 +297,7 @@ def runs(flags: np.ndarray, length: int) -> list[int]:
     return [int(s) for s in range(len(flags) - length + 1) if c[s + length] - c[s] == length]
 
 
+@cache
 def following(relative: str, seconds: float = 3.0) -> dict[tuple[int, int], list[int]]:
     """(ego, lead) -> window starts in which, at every frame, the lead is in the ego's lanes 0-30 m
     ahead and both move faster than 1 m/s."""
@@ -340,6 +345,7 @@ def fits(observed: np.ndarray, first: int, last: int, window: int) -> bool:
     )
 
 
+@cache
 def overtaking(relative: str, seconds: float = 4.0) -> dict[tuple[int, int], list[int]]:
     """(ego, vehicle) -> frames where the vehicle, in a lane beside the moving ego's, is behind it
     and is ahead of it within ``seconds``, beside it all the while."""
@@ -355,6 +361,7 @@ def overtaking(relative: str, seconds: float = 4.0) -> dict[tuple[int, int], lis
     return out
 
 
+@cache
 def overtaken_on_right_while_followed(relative: str, seconds: float = 4.0) -> dict[tuple[int, int, int], list[int]]:
     """(ego, lead, passer) -> frames where the ego follows the lead (as :func:`following`, frame by
     frame) while the passer, in the lane to the lead's right, is behind the lead and ahead of it

@@ -627,13 +627,14 @@ def test_followed_but_not_overtaken_on_right():
 def test_counts_of_the_lane_change_queries():
     """Object level, (recording, vehicle), 1007 vehicles. Left: every raw left change is found (13);
     the 18 others are vehicles the labeller sees moving left without a lane step to a left
-    neighbour in the raw lanes: vehicles settling into a lane after a turn (Waymo ScenarioNet 5, 25,
-    29, 33, 38: heading still turning, 3.5 m off the centreline), drifts within a wide lane or a
-    lane change the map's lanes do not show (CommonRoad Lanker 1266, US101-4_1 375), AV2 688118c3
-    reversing. Accelerating right: the one raw case (nuScenes 1100 0ba56cee) is found; AV2 7fab2350
-    d5bc0f50 speeds up 7.3 -> 8.4 m/s in frames 40-62 while it starts moving right, but its lane
-    step (frame 68) is flat (-0.2 m/s over 2 s); US101-4_1 389 speeds up 15 -> 18 m/s while moving
-    1.7 m right but never leaves its lanelet."""
+    neighbour in the raw lanes, e.g. vehicles settling into their lane after a turn (Waymo
+    ScenarioNet 29 and 33: heading still turning, up to 3.5 m off the new lane's centreline, which
+    is a successor, not a neighbour), AV2 7fab2350 688118c3 reversing at 0.4-0.8 m/s, and sideways
+    drifts that never leave the lane (CommonRoad Lanker 1266, US101-4_1 375). Accelerating right:
+    the one raw case (nuScenes 1100 0ba56cee) is found; AV2 7fab2350 d5bc0f50 speeds up 7.3 -> 8.4
+    m/s in frames 40-62 while it starts moving right, but its lane step (frame 68) is flat (-0.2 m/s
+    over 2 s); US101-4_1 389 speeds up 15 -> 18 m/s while moving 1.7 m right but never leaves its
+    lanelet."""
     units = vehicle_units()
     assert len(units) == 1007
     assert confusion(changing_lanes("left"), predicted(LEFT, "car"), units) == (13, 18, 0, 976)
@@ -655,14 +656,14 @@ def test_counts_of_the_following_and_overtaking_queries():
     """Object level, (recording, other vehicle): the lead (following), the overtaking car, the
     passer (overtaken on the right); 1007 vehicles. Following: 26/0/6/975; the misses are same-lane
     leads more than 1.5 m off the ego's axis (CommonRoad US101-4_1 451: 3.9 m; Lanker 1253 changing
-    into the lane, 7.8 m) and AV2 adcf7d18 d1cc41fe. Overtaking: 8/1/3/995; misses: passes that
+    into the lane, 7.8 m; AV2 adcf7d18 d1cc41fe: 3.9 m). Overtaking: 8/1/3/995; misses: passes that
     begin less than 4 s before the recording ends, so that no 4 s window starting behind fits (AV2
     7fab2350 d5bc0f50 at frame 119 of 156: a window containing it starts with the ego at 0.55 m/s;
     Lanker 1267/1270 at frames 35-37 of 41); the false hit, CommonRoad Peach 569, drives side by
     side with 566 (never more than 0.4 m ahead) in lanelets the map does not mark adjacent.
     Overtaken on the right: 3/0/1/1003, every positive on CommonRoad (no recording with an ego
-    has one); the miss, US101-4_1 395, passes 422 and 427 while their followers are 1.5-2 m off
-    their axes."""
+    has one); the miss, US101-4_1 395, passes 442 (its follower 451 is up to 1.53 m off 442's
+    axis, and 395 starts exactly 2.0 m to its side) and 451 (its follower 468 is 3.9 m off its axis)."""
     units = vehicle_units()
 
     def truth(function, position):

@@ -16,7 +16,8 @@ Raw-data vocabulary used by every truth below (see the helpers):
 * a *lane change* to a side is a step (one frame) from lane A to lane B where B is A's neighbour
   on that side with traffic the same way (also through one successor or predecessor hop), outside
   intersections, with the vehicle's sideways motion across its lane's direction over the 2 s
-  either side at least 1.2 m towards that side (so a box centre jittering on a boundary is none);
+  either side at least 1.2 m towards that side (so a box centre jittering on a boundary is none):
+  RefAV's own ``changing_lanes`` rule is such a step to the lane's neighbour id;
 * the ego is the recording's ego; CommonRoad recordings have none (the planning problem's vehicle
   is not an object), so a program's ego may be any car there (README: "the program's ego is the
   trace's ego object when the trace names one"), and the truths take every car as the ego.

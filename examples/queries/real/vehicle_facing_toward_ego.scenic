@@ -1,0 +1,10 @@
+# Finds: a vehicle within 30 m whose heading points at the ego, within 30 deg, for the whole window, moving or not (RefAV "facing toward" the ego)
+# Run: scenario window=1s unknown_layers=permissive all=true
+# Scenic's apparent heading of X from the ego is X's heading minus the bearing of X from the ego:
+# 0 when X faces away, +-180 deg when it faces the ego.
+model scenic.simulators.newtonian.driving_model
+
+ego = new Car in everywhere, with behavior AnyBehavior(), with roadDeviation Range(-180, 180) deg, with regionContainedIn everywhere
+other = new Vehicle in everywhere, with behavior AnyBehavior(), with roadDeviation Range(-180, 180) deg, with regionContainedIn everywhere
+require always abs(apparent heading of other from ego) > 150 deg
+require always (distance to other) < 30

@@ -2,6 +2,10 @@
 # Run: scenario window=3s unknown_layers=permissive all=true
 # The side of the ego's path it is on is the sign of its bearing relative to the ego's heading,
 # (relative heading of (angle from ego to other) from ego): positive on the left.
+# Every object is 'in everywhere' with a free heading and region: Scenic's defaults put a
+# vehicle on the road, facing along its lane, box inside the road; parked and turning
+# vehicles are not.
+# Scenic's Vehicle includes bicycles (a Bicycle is a Vehicle); say Car, Truck, Bus... to leave them out.
 model scenic.simulators.newtonian.driving_model
 
 ego = new Car in everywhere, with behavior AnyBehavior(), with roadDeviation Range(-180, 180) deg, with regionContainedIn everywhere

@@ -2,6 +2,10 @@
 # Run: scenario window=1s unknown_layers=permissive all=true
 # Scenic's apparent heading of X from the ego is X's heading minus the bearing of X from the ego:
 # 0 when X faces away, +-180 deg when it faces the ego.
+# Every object is 'in everywhere' with a free heading and region: Scenic's defaults put a
+# vehicle on the road, facing along its lane, box inside the road; parked and turning
+# vehicles are not.
+# Scenic's Vehicle includes bicycles (a Bicycle is a Vehicle); say Car, Truck, Bus... to leave them out.
 model scenic.simulators.newtonian.driving_model
 
 ego = new Car in everywhere, with behavior AnyBehavior(), with roadDeviation Range(-180, 180) deg, with regionContainedIn everywhere

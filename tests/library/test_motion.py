@@ -85,7 +85,7 @@ def found(name: str, recording: str) -> dict[str, list[tuple[int, int]]]:
 
 
 # ---------------------------------------------------------------- raw numbers
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Raw:
     """One recording as dense (object, frame) arrays: NaN where the object is not observed."""
 
@@ -238,6 +238,18 @@ WINDOW = {
 """The queries' windows in frames (all recordings are 10 Hz)."""
 
 
+@cache
+def deceleration(r: Raw, k: int, m: int) -> np.ndarray:
+    """Per window start, object k's deceleration over m frames (m/s^2): minus the median slope of
+    its speed over every pair of the window's frames (Theil-Sen), which one jumpy box (AV2
+    adcf7d18's d1cc41fe at frame 126) cannot fake, as it could the difference of the end speeds."""
+    v = r.speed[k]
+    i, j = np.triu_indices(m, 1)
+    starts = np.arange(len(v) - m + 1)[:, None]
+    with np.errstate(invalid="ignore"):
+        return -np.median((v[starts + j] - v[starts + i]) / ((j - i) * 0.1), axis=1)
+
+
 def pair_truth(name: str, r: Raw, ego: int, other: int) -> np.ndarray:
     m = WINDOW[name]
     p = pair(r, ego, other)
@@ -257,11 +269,8 @@ def pair_truth(name: str, r: Raw, ego: int, other: int) -> np.ndarray:
             ahead = (
                 (p.ahead > 2) & (p.ahead < 40) & (np.abs(p.left) < 2) & (np.abs(p.relative_heading) < np.radians(30))
             )
-            v = p.speed
-            n = len(v) - m + 1
-            drop = np.full(n, np.nan)
-            drop[:] = (v[:n] - v[m - 1 :]) / ((m - 1) * 0.1)  # mean deceleration over the window
-            return windows_all(p.both & ahead & (p.ego_speed > 0.5), m) & (drop > 1.0)
+            drop = deceleration(r, other, m)
+            return windows_all(p.both & ahead & (p.ego_speed > 0.5), m) & (drop > 2.0)
         if name == "vehicle_facing_toward_ego":
             return windows_all(p.both & (p.facing < np.radians(30)) & (p.distance < 30), m)
         if name == "vehicle_heading_toward_ego":
@@ -295,14 +304,17 @@ def candidates(name: str, recording: str) -> set:
 
 @cache
 def confusion(name: str) -> dict[str, set]:
-    """TP/FP/FN/TN units of one situation over every recording."""
+    """TP/FP/FN/TN units of one situation over every recording. An object unit is a TP only when
+    one of the query's windows for it overlaps one of the truth's; an answer at the wrong time
+    counts as an FP and, if the truth has the object elsewhere, an FN too."""
     out: dict[str, set] = {"TP": set(), "FP": set(), "FN": set(), "TN": set()}
     for recording in catalog.RECORDINGS:
         query = units(name, recording, found(name, recording))
         truth = units(name, recording, truth_windows(name, recording))
-        out["TP"] |= query & truth
-        out["FP"] |= query - truth
-        out["FN"] |= truth - query
+        right = {unit for unit in query & truth if not isinstance(unit, tuple) or overlaps(name, *unit)}
+        out["TP"] |= right
+        out["FP"] |= query - right
+        out["FN"] |= truth - right
         out["TN"] |= candidates(name, recording) - query - truth
     return out
 
@@ -611,11 +623,8 @@ DISAGREEMENTS = {
 @pytest.mark.parametrize("name", NAMES)
 def test_counts_over_every_recording(name):
     """Per situation, TP/FP/FN/TN against the raw-data truth over the 20 recordings; every FP and
-    FN is one of the disagreements explained above, and every TP's windows overlap the truth's."""
+    FN is one of the disagreements explained above."""
     c = confusion(name)
     assert tuple(len(c[k]) for k in ("TP", "FP", "FN", "TN")) == COUNTS[name]
     wrong = {(kind, short(unit)) for kind in ("FP", "FN") for unit in c[kind]}
     assert wrong == {(kind, unit) for (n, kind, unit) in DISAGREEMENTS if n == name}
-    for unit in c["TP"]:
-        if isinstance(unit, tuple):
-            assert overlaps(name, *unit), unit

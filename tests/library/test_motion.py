@@ -74,6 +74,7 @@ def all_matches() -> dict[tuple[str, str], tuple[dict, ...]]:
     }
 
 
+@cache
 def found(name: str, recording: str) -> dict[str, list[tuple[int, int]]]:
     """The query's answers: the label object in the situation's role (the ego for ``ego_*``) ->
     its matching windows (first, last frame)."""
@@ -180,8 +181,12 @@ def pair(r: Raw, ego: int, other: int) -> Pair:
     to_ego = np.arctan2(dx, -dy)  # Scenic heading of the vector (-dx, -dy), from the other to the ego
     velocity_heading = np.arctan2(-r.vx[other], r.vy[other])
     both = r.present[ego] & r.present[other]
-    closing = np.full_like(distance, np.nan)
+    closing = np.full_like(distance, np.nan)  # central differences, one-sided at a run's ends
     closing[1:-1] = (distance[2:] - distance[:-2]) / 0.2
+    forward = np.append((distance[1:] - distance[:-1]) / 0.1, np.nan)
+    backward = np.insert((distance[1:] - distance[:-1]) / 0.1, 0, np.nan)
+    closing = np.where(np.isnan(closing), forward, closing)
+    closing = np.where(np.isnan(closing), backward, closing)
     return Pair(
         ahead,
         left,
@@ -196,6 +201,7 @@ def pair(r: Raw, ego: int, other: int) -> Pair:
     )
 
 
+@cache
 def truth_windows(name: str, recording: str) -> dict[str, np.ndarray]:
     """The raw-data truth: the label object in the situation's role -> the starts of the windows
     in which the situation holds (with some ego, for the object situations)."""
@@ -417,8 +423,8 @@ def runs_above(v: np.ndarray, limit: float) -> int:
 def test_ego_high_speed_positives():
     """nuScenes scene-1077: the ego drives above 13.9 m/s (its position's rate) for runs of 30
     frames and more, and the answer's window (frames 114-143, where the recorded velocities all
-    exceed 13.9 m/s) is at 13.86-15.1 m/s; CommonRoad US101-4_1 (no recorded ego: any car plays it): car 389 drives 15.2-18.4
-    m/s for its whole 6 s track."""
+    exceed 13.9 m/s) is at 13.86-15.1 m/s; CommonRoad US101-4_1 (no recorded ego: any car plays
+    it): car 389 drives 15.2-18.4 m/s for its whole 6 s track."""
     scene = NUSC.format("1077")
     v = raw(scene).speed[raw(scene).egos[0]]
     assert runs_above(v, 13.9) >= 30
@@ -443,15 +449,15 @@ def test_ego_high_speed_negatives():
 
 # ---------------------------------------------------------------- 3. lead vehicle braking
 def test_lead_vehicle_braking_positives():
-    """CommonRoad US101-3_3 (cars play the ego): car 363 drives 5-12 m ahead of another car in its
-    lane and slows by over 1 m/s per second over the first second; Peach-4_8: car 560 brakes
-    ahead of car 566 from frame 16 on."""
-    for recording, lead, ego in ((US101_3, "363", None), (PEACH, "560", "566")):
+    """CommonRoad US101-3_3 (cars play the ego): car 363 drives ahead of another car in its lane
+    and slows by over 2 m/s per second (Theil-Sen slope) over its first second; Peach-4_8: car 560
+    brakes ahead of car 566 from frame 16 on."""
+    for recording, lead in ((US101_3, "363"), (PEACH, "560")):
         frames = window_of("lead_vehicle_braking", recording, lead)
         windows = answered("lead_vehicle_braking", recording, lead)
         assert windows and any(abs(first - frames.start) < 10 for first, _ in windows)
         v = raw(recording).speed[obj(recording, lead)]
-        assert v[frames.start] - v[frames.stop - 1] > 0.9  # over 1 m/s^2 for 0.9 s
+        assert v[frames.start] - v[frames.stop - 1] > 1.8  # over 2 m/s^2 for 0.9 s
     p = ego_pair(PEACH, "560", "566")
     at = window_of("lead_vehicle_braking", PEACH, "560")
     assert (p.ahead[at] > 2).all() and (np.abs(p.left[at]) < 2).all()
@@ -471,16 +477,20 @@ def test_lead_vehicle_braking_negatives():
 
 # ---------------------------------------------------------------- 4. ego accelerating from standstill
 def test_ego_accelerating_from_stop_positives():
-    """AV2 adcf7d18: the ego stands (0.0 m/s) for frames 0-47, then speeds up to 3 m/s by frame
-    67; AV2 7fab2350: it stands at frames ~100-113 after braking, then passes 3 m/s at frame 134;
-    nuScenes scene-1094: it creeps at 0.1-0.2 m/s for frames 0-10, 3 m/s by frame 45."""
-    for recording, stand, go in ((AV2_START, 47, 67), (AV2_STOP, 105, 134), (NUSC.format("1094"), 5, 45)):
+    """AV2 adcf7d18: the ego stands (under 0.5 m/s) until frame 51, passes 3 m/s at frame 68;
+    AV2 7fab2350: after braking to a stop it stands until frame 115, passes 3 m/s at frame 136;
+    nuScenes scene-1094: it creeps under 0.5 m/s until frame 13, passes 3 m/s at frame 45. The
+    answer (the first window; the file does not ask for all) starts standing and ends over 3 m/s."""
+    for recording, stand, go, first in (
+        (AV2_START, 51, 68, 19),
+        (AV2_STOP, 115, 136, 96),
+        (NUSC.format("1094"), 13, 45, 0),
+    ):
         v = raw(recording).speed[raw(recording).egos[0]]
-        assert v[stand] < 0.5 and v[go] > 3 - 0.2 and go - stand < 50
-        windows = found("ego_accelerating_from_stop", recording)["ego"]
-        for first, last in windows:
-            assert v[first] < 0.5 and v[first : last + 1].max() > 3
-        assert any(first <= stand and go <= last for first, last in windows) or recording == AV2_STOP
+        assert np.flatnonzero(v < 0.5)[-1] == stand
+        assert np.flatnonzero((v > 3) & (np.arange(len(v)) > stand))[0] == go
+        ((start, last),) = found("ego_accelerating_from_stop", recording)["ego"]
+        assert start == first and v[start] < 0.5 and v[start : last + 1].max() > 3 and go <= last
 
 
 def test_ego_accelerating_from_stop_negatives():
@@ -611,12 +621,57 @@ def test_vehicle_crossing_ego_path_negatives():
 
 
 # ---------------------------------------------------------------- counts over every recording
-COUNTS = {
-    # name: (TP, FP, FN, TN); units: recordings for ego_*, (recording, vehicle) otherwise
+COUNTS = {  # name: (TP, FP, FN, TN); units: recordings for ego_*, (recording, vehicle) otherwise
+    "stationary_vehicle": (393, 10, 1, 614),
+    "ego_high_speed": (2, 0, 0, 18),
+    "lead_vehicle_braking": (10, 2, 6, 1000),
+    "ego_accelerating_from_stop": (6, 0, 0, 14),
+    "vehicle_facing_toward_ego": (268, 0, 0, 750),
+    "vehicle_heading_toward_ego": (86, 1, 2, 929),
+    "oncoming_vehicle": (72, 0, 0, 946),
+    "vehicle_crossing_ego_path": (28, 0, 0, 990),
 }
 
-DISAGREEMENTS = {
-    # (name, "FP" | "FN", short unit): why the query and the raw-data truth differ
+CREEPS = "creeps 0.5-2.1 m in the 5 s at up to 0.5-2.7 m/s, under the Stationary speed once smoothed over 1 s"
+SHORT_BRAKE = "labelled Brake for 5-7 frames only, fewer than the 1 s window's 10"
+DIP = "a speed dip of about 0.5 s (1236: 7.7 to 3.4 and back to 7.3 m/s) the labeller's 1 s smoothing averages away"
+LANKER_VELOCITIES = (
+    "CommonRoad records speed along the orientation: by positions the gap to the ego shrinks by "
+    "0.02-0.8 m/s, by the velocities it grows by up to 5 m/s"
+)
+DISAGREEMENTS = {  # (name, "FP" | "FN", unit): why the query and the raw-data truth differ
+    **{
+        ("stationary_vehicle", "FP", unit): CREEPS
+        for unit in (
+            "0a1e6f0a/139510",
+            "0a1e6f0a/139591",
+            "0a1e6f0a/139613",
+            "adcf7d18/27c0efd0",
+            "adcf7d18/bb4f0921",
+            "scene-0655/2026e171",
+            "scene-1077/f8feea7f",
+            "scene-1100/90a12461",
+            "scene-1100/c7925b44",
+            "sd_waymo_v1.2_eb4b91b10ca94ff2/13",
+        )
+    },
+    ("stationary_vehicle", "FN", "0a1e6f0a/138951"): "it comes to a stop as its one truth window starts (1.2 m/s "
+    "0.5 s before): the labeller's 1 s smoothing still has it moving at the window's first frames",
+    ("lead_vehicle_braking", "FP", "US101-4_1/395"): "labelled Brake for 10 frames at 1.55 m/s^2, over the "
+    "labeller's 1 m/s^2 but under the 2 m/s^2 of the situation",
+    ("lead_vehicle_braking", "FP", "scene-1094/3f81e988"): "labelled Brake at the scene's last frames, where "
+    "nuScenes' recorded velocity drops to 0; its positions keep a steady 12.45 m/s",
+    ("lead_vehicle_braking", "FN", "Lanker-1_1/1216"): DIP,
+    ("lead_vehicle_braking", "FN", "Lanker-1_1/1236"): DIP,
+    ("lead_vehicle_braking", "FN", "US101-4_1/384"): SHORT_BRAKE,
+    ("lead_vehicle_braking", "FN", "US101-4_1/422"): SHORT_BRAKE,
+    ("lead_vehicle_braking", "FN", "US101-4_1/442"): SHORT_BRAKE,
+    ("lead_vehicle_braking", "FN", "scene-1077/ed634e83"): "nuScenes' speeds step at its 2 Hz keyframes; the "
+    "steps down are labelled Brake for 4 and 9 frames, under the 10-frame window",
+    ("vehicle_heading_toward_ego", "FP", "US101-4_1/384"): "it follows car 380 at its speed: by positions the "
+    "gap grows by 0.02-0.06 m/s at frames 2-3, by the velocities it shrinks by 0.1-0.6 m/s",
+    ("vehicle_heading_toward_ego", "FN", "Lanker-1_1/1253"): LANKER_VELOCITIES,
+    ("vehicle_heading_toward_ego", "FN", "Lanker-1_1/1257"): LANKER_VELOCITIES,
 }
 
 

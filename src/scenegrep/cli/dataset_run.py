@@ -55,12 +55,10 @@ def run_query_command(
     """Run a query over ``paths`` or ``args.dataset``, print its results; returns the exit code."""
     from .. import readers
     from ..dataset import QuerySpec
-    from ..dataset.queries import spec_choice
+    from ..dataset.queries import uses_map
+    from ..model.layers import UnknownLayers
 
     spec = QuerySpec.of(kind, query, origin, **options)
-    choice = None if kind == "spre" else spec_choice(spec)
-    if choice is not None:
-        choice.decisions.clear()  # the choice is shared by the process; count this run's decisions
     if getattr(args, "map", None):
         readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
     printer = RowPrinter(args)
@@ -73,8 +71,8 @@ def run_query_command(
     counts = results.counts()
     if not args.quiet:
         _summary(results, where or (f"; results in {args.output}" if args.output else ""))
-    if choice is not None:
-        report_unknown_layers(choice, counted=not args.dataset)
+    if uses_map(spec):
+        report_unknown_layers(UnknownLayers(spec.option("unknown_layers"), Counter(results.assumed)))
         if not counts["matched"]:
             _nearest_misses(spec, results, args)
     if results.status == "interrupted":

@@ -89,12 +89,12 @@ def test_angular_speed_is_unknown_in_every_trace():
 
 
 def test_the_cli_reports_an_unknown_speed_in_one_line_and_fails_the_trace(tmp_path, capsys):
-    """The trace lacks what the query needs: that trace fails (exit 3), its error on one line."""
+    """The lone trace lacks what the query needs: a user error (exit 2) on one line."""
     (tmp_path / "fast.scenic").write_text(HEADER + "ego = new Object at (1.75, 20), with speed Range(13.9, 40)\n")
     write_trace_json(trace_of({"ego": UNKNOWN}), tmp_path / "t.json")
     code = main(["scene", str(tmp_path / "fast.scenic"), str(tmp_path / "t.json")])
-    err = [line for line in capsys.readouterr().err.splitlines() if line.startswith("scenegrep: failed: ")]
-    assert code == 3 and len(err) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert code == 2 and len(err) == 1 and err[0].startswith("scenegrep: error: ")
     assert err[0].endswith("t.json: ego.speed is unknown: trace 'hand' has no speed for object 'ego' at frame 0")
 
 

@@ -2,7 +2,8 @@
 
 Over files, the dataset engine's query (:mod:`.dataset_run`): one line per match,
 ``NAME:START-END`` (dataset frame indices of the first and last frame), or the results table
-with ``--json``, ``--csv`` or ``--output``; a bad file is a failed row (exit code 3). As STREM
+with ``--json``, ``--csv`` or ``--output``; a bad file is a failed row (exit code 3), or given
+alone a user error (exit code 2). As STREM
 does (``--compat strem``, ``--online``, ``--export``, standard input): each stream searched as it
 is read, ``PATH:START-END`` (``PATH:START..END``, STREM's first index .. last index + 1, with
 ``--compat strem``; no path for standard input), and the first bad input ends the command (exit

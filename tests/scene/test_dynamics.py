@@ -8,9 +8,6 @@ frames computed here from the recording's own ``velocity_x`` / ``velocity_y`` co
 
 from __future__ import annotations
 
-import dataclasses
-import textwrap
-from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -19,14 +16,13 @@ import pytest
 from scenegrep.cli.main import main
 from scenegrep.errors import UserError
 from scenegrep.model.layers import UnknownLayers
-from scenegrep.model import BehaviourLabels
 from scenegrep.readers.av2_forecasting import read_trace
 from scenegrep.readers.av2_sensor import read_trace as read_sensor_log
 from scenegrep.scenario import ScenarioOptions, compile_scenario
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
 from scenegrep.scene.misses import nearest_miss
 from scenegrep.writers.trace_json import write_trace_json
-from tests.scene.frames import HEADER, MAP, av2_ego_velocity, matches, trace_of
+from tests.scene.frames import AV2, HEADER, MAP, all_driving, av2_ego_velocity, drive_stop_go, matches, trace_of
 
 MOVING = ("Car", 1.75, 20.0, 0.0, 4.5, 2.0, 0.0, 10.0)  # northbound at 10 m/s
 DRIFTING = ("Car", 1.75, 20.0, 0.0, 4.5, 2.0, 6.0, 8.0)  # 10 m/s, but not along the heading
@@ -108,7 +104,6 @@ def test_the_cli_speed_tolerance(tmp_path, capsys):
 
 
 # ---------------------------------------------------------------------------- a real recording
-AV2 = Path(__file__).parents[2].parent / "shared/real_data/av2/forecasting/0a1e6f0a-1817-4a98-b02e-db8c9327d151"
 ANYWHERE = "ego = new Object in everywhere, facing Range(0, 360) deg"
 
 
@@ -138,27 +133,14 @@ def test_speed_in_a_scenario_guard_and_require_on_a_real_recording(recording):
     """Every frame is labeled Drive and none Stop, so a window matches when the ego's speed exceeds
     5 m/s at its first frame (the require: the initial scene) and stays at or above 1 m/s in every
     frame of it (the guard never ends Drive)."""
-    program = textwrap.dedent(f"""\
-        behavior Drive():
-            while True:
-                wait
-        behavior Stop():
-            while True:
-                wait
-        behavior Go():
-            do Drive() until self.speed < 1
-            do Stop()
-        {ANYWHERE}, with behavior Go()
-        require ego.speed > 5
-        """)
+    program = drive_stop_go("self.speed < 1", f"{ANYWHERE}, with behavior Go()\nrequire ego.speed > 5\n")
     trace, speed = recording
-    labeled = dataclasses.replace(trace, behaviours=BehaviourLabels.from_sets([{"Drive"}] * len(trace.states)))
     window = 15
     starts = range(len(speed) - window + 1)
     expected = [s for s in starts if speed[s] > 5 and (speed[s : s + window] >= 1).all()]
     assert expected == [*range(19), *range(69, 96)]  # 19..23 start fast but reach 0.81 m/s at timestep 33
-    query = compile_scenario(HEADER + program, "go.scenic")
-    result = query.match(labeled, window, None, ScenarioOptions(find_all=True))
+    query = compile_scenario(program, "go.scenic")
+    result = query.match(all_driving(trace), window, None, ScenarioOptions(find_all=True))
     assert [(m.correspondence, m.starts.tolist()) for m in result.matches] == [({"ego": "AV"}, expected)]
 
 

@@ -27,7 +27,7 @@ from typing import Any
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from .catalog import Catalog
+from .catalog import Catalog, catalog_file
 from .execute import default_jobs, run_all
 from .plan import Plan, needs_of, plan
 from .queries import ORDER, QuerySpec, TraceTask, compiled, pruned_row, results_table, run_tasks
@@ -94,13 +94,14 @@ def identity_of(row: dict[str, Any]) -> dict[str, Any]:
 
 
 def _task(root: Path, row: dict[str, Any], maps: dict[str, str]) -> TraceTask:
+    """The task of a catalog ``traces`` row (UserError if the catalog names its files outside the dataset)."""
     map_file = maps.get(row["map_id"]) if row["map_id"] else None
     return TraceTask(
         row["trace_id"],
         row["name"],
         row["source_path"],
-        str(root / row["file"]),
-        None if map_file is None else str(root / map_file),
+        str(catalog_file(root, row["file"])),
+        None if map_file is None else str(catalog_file(root, map_file)),
         row["time_origin_ns"],
     )
 

@@ -25,9 +25,7 @@ from typing import Any
 
 from .inputs import is_one_input
 from .layers import report_unknown_layers
-from .main import EXIT_INTERRUPTED, EXIT_SOME_FAILED
-
-NO_MATCH = 1
+from .main import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
 
 
 def add_dataset_arguments(parser: argparse.ArgumentParser) -> None:
@@ -82,7 +80,7 @@ def run_query_command(
         return EXIT_INTERRUPTED
     if counts["failed"]:
         return EXIT_SOME_FAILED
-    return 0 if counts["matched"] else NO_MATCH
+    return 0 if counts["matched"] else EXIT_NO_MATCH
 
 
 def _over_files(args: argparse.Namespace, spec: Any, paths: list[str], printer: RowPrinter) -> Any:

@@ -18,8 +18,7 @@ import sys
 from typing import Any
 
 from .dataset_run import add_dataset_arguments, reject_dataset_only, run_query_command
-
-NO_MATCH = 1
+from .main import EXIT_NO_MATCH
 
 
 def add_parser(subparsers: Any) -> None:
@@ -149,4 +148,4 @@ def _run_streams(args: argparse.Namespace) -> int:
             matches = bound.online() if args.online else bound.offline()
             prefix = "" if path == "-" else f"{path}#{trace.name}" if many else path
             found |= _report(matches, prefix, args, options, bound.trace)
-    return 0 if found else NO_MATCH
+    return 0 if found else EXIT_NO_MATCH

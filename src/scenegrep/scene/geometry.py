@@ -190,10 +190,8 @@ class MapGeometry:
 
     def _boxes_meet(self, region: Region, x_lo, x_hi, y_lo, y_hi, value: Values) -> np.ndarray:
         n = len(x_lo)
-        if isinstance(region, Everywhere):
-            return np.ones(n, dtype=bool)
-        if isinstance(region, Nowhere):
-            return np.zeros(n, dtype=bool)
+        if (constant := _constant(region, n)) is not None:
+            return constant
         if isinstance(region, MapRegion):
             boxes = shapely.box(x_lo, y_lo, x_hi, y_hi)
             if region.layer == "curb":
@@ -301,10 +299,8 @@ class MapGeometry:
 
     def _contains_boxes(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         n = len(np.atleast_1d(x))
-        if isinstance(region, Everywhere):
-            return np.ones(n, dtype=bool)
-        if isinstance(region, Nowhere):
-            return np.zeros(n, dtype=bool)
+        if (constant := _constant(region, n)) is not None:
+            return constant
         if isinstance(region, Sector):
             return shapes.boxes_in_sectors(x, y, heading, length, width, *(value(t) for t in region.terms()))
         if isinstance(region, Intersection):
@@ -330,10 +326,8 @@ class MapGeometry:
 
     def _boxes_meet_oriented(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         n = len(np.atleast_1d(x))
-        if isinstance(region, Everywhere):
-            return np.ones(n, dtype=bool)
-        if isinstance(region, Nowhere):
-            return np.zeros(n, dtype=bool)
+        if (constant := _constant(region, n)) is not None:
+            return constant
         if isinstance(region, Sector):
             return shapes.boxes_meet_sectors(x, y, heading, length, width, *(value(t) for t in region.terms()))
         if isinstance(region, Union):
@@ -633,6 +627,16 @@ def _segment_distances(start: np.ndarray, end: np.ndarray, px: float, py: float)
         1,
     )
     return np.hypot(start[:, 0] + t * d[:, 0] - px, start[:, 1] + t * d[:, 1] - py)
+
+
+def _constant(region: Region, n: int) -> np.ndarray | None:
+    """The answer for each of ``n`` rows where the region decides it alone: all True everywhere,
+    all False nowhere; None for any other region."""
+    if isinstance(region, Everywhere):
+        return np.ones(n, dtype=bool)
+    if isinstance(region, Nowhere):
+        return np.zeros(n, dtype=bool)
+    return None
 
 
 def _box_polygons(x, y, heading, length, width) -> np.ndarray:

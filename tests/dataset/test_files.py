@@ -226,7 +226,32 @@ def test_dataset_workers_report_the_unknown_layer_decisions_of_files(mode, real_
 
 def _pedestrian_states(folder: Path) -> int:
     """The pedestrian states of the traces in ``folder``: each is one decision on the crossing layer."""
+    return sum(_pedestrian_states_of(path) for path in sorted(folder.iterdir()))
+
+
+def _pedestrian_states_of(path: Path) -> int:
+    """The pedestrian states of the trace in the file ``path``."""
     from scenegrep import readers
 
-    traces = [readers.read_trace(path) for path in sorted(folder.iterdir())]
-    return sum(int((t.objects.kinds()[t.states.object] == "pedestrian").sum()) for t in traces)
+    trace = readers.read_trace(path)
+    return int((trace.objects.kinds()[trace.states.object] == "pedestrian").sum())
+
+
+@pytest.mark.real_data
+def test_a_resumed_run_counts_the_decisions_of_the_parts_it_keeps(real_data, tmp_path):
+    """Each part keeps its chunk's count: a run resumed after losing one part counts what the
+    whole run counted, not only the traces it queried again."""
+    from scenegrep.dataset import QuerySpec
+    from scenegrep.dataset.ingest import ingest
+    from scenegrep.dataset.run import RunOptions, run_query
+
+    recordings = sorted((real_data / "nuscenes_mini_scenarionet").iterdir())[:3]
+    root = tmp_path / "fleet"
+    assert not ingest([str(p) for p in recordings], root, jobs=1, label=False).failed
+    spec = QuerySpec.of("scene", CROSSING_QUERY, unknown_layers="strict", values=False)
+    whole = run_query(root, spec, RunOptions(jobs=3))
+    parts = sorted((root / "runs" / whole.run_id / "parts").glob("*.parquet"))
+    assert len(parts) == 3
+    parts[0].unlink()
+    resumed = run_query(root, spec, RunOptions(jobs=1, resume=True))
+    assert whole.assumed == resumed.assumed == {"crossing": sum(_pedestrian_states_of(p) for p in recordings)}

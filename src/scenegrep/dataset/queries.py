@@ -240,11 +240,10 @@ def spec_choice(spec: QuerySpec) -> Any:
 def decisions_while(spec: QuerySpec, action: Callable[[], T]) -> tuple[T, dict[str, int]]:
     """``action()``'s result and, per layer, the decisions the spec's choice for unknown map layers
     counted while it ran (none for a SpRE, which reads no map): this process's part of a run."""
-    choice = spec_choice(spec) if uses_map(spec) else None
-    before = Counter(choice.decisions) if choice is not None else Counter()
+    counts: Counter[str] = spec_choice(spec).decisions if uses_map(spec) else Counter()
+    before = Counter(counts)
     result = action()
-    after = Counter(choice.decisions) if choice is not None else Counter()
-    return result, dict(after - before)
+    return result, dict(counts - before)
 
 
 @cache

@@ -79,7 +79,7 @@ def test_commands_print_names_escaped(evil, capsys, command, shown):
 def test_an_error_line_quoting_the_input_is_escaped(tmp_path, capsys):
     path = tmp_path / "bad.json"
     path.write_bytes(b'{"version": "0.2.0", "frames": [\x1b[2J]}')
-    assert main(["spre", "[[:car:]]", str(path)]) == 3  # the file fails; its error line is escaped
+    assert main(["spre", "[[:car:]]", str(path)]) == 2  # the lone file fails; its error line is escaped
     assert "\\x1b" in _printed(capsys)
 
 

@@ -191,3 +191,67 @@ def test_results_of_a_query_over_files_open_in_show_report_and_export(folder, tm
     assert 'data-count="matches"><b>3</b>' in report and "parkedCar" in report
     assert main(["export", str(results), "--mcap", str(tmp_path / "m.mcap"), "-q"]) == 0
     assert (tmp_path / "m.mcap").stat().st_size > 0
+
+
+CROSSING_QUERY = (
+    "model scenic.domains.driving.model\n"
+    "ego = new Car on road, facing Range(-180, 180) deg, with regionContainedIn None\n"
+    "ped = new Pedestrian in crossing, with regionContainedIn None\n"
+)
+
+
+def _unknown_layers_line(err: list[str]) -> list[str]:
+    return [line for line in err if line.startswith("scenegrep: --unknown-layers")]
+
+
+@pytest.mark.real_data
+@pytest.mark.parametrize("mode", ["permissive", "strict"])
+def test_dataset_workers_report_the_unknown_layer_decisions_of_files(mode, real_data, tmp_path, capsys):
+    """The nuScenes recordings publish no crosswalks: a query that needs them reports on stderr how
+    many decisions the choice affected; a dataset run whose workers (two processes) made them
+    reports the same count as the query over the same files."""
+    from scenegrep.dataset.ingest import ingest
+
+    recordings = real_data / "nuscenes_mini_scenarionet"
+    program = tmp_path / "crossing.scenic"
+    program.write_text(CROSSING_QUERY)
+    assert not ingest([str(recordings)], tmp_path / "fleet", jobs=2, label=False).failed
+    options = ["--unknown-layers", mode, "--no-values", "-q"]
+    _, _, over_files = run(["scene", program, recordings, *options], capsys)
+    _, _, over_dataset = run(["scene", program, *options, "--dataset", tmp_path / "fleet", "-j", "2"], capsys)
+    (line,) = _unknown_layers_line(over_files)
+    assert line.endswith(f"; decisions affected: crossing {_pedestrian_states(recordings)}"), line
+    assert _unknown_layers_line(over_dataset) == [line]
+
+
+def _pedestrian_states(folder: Path) -> int:
+    """The pedestrian states of the traces in ``folder``: each is one decision on the crossing layer."""
+    return sum(_pedestrian_states_of(path) for path in sorted(folder.iterdir()))
+
+
+def _pedestrian_states_of(path: Path) -> int:
+    """The pedestrian states of the trace in the file ``path``."""
+    from scenegrep import readers
+
+    trace = readers.read_trace(path)
+    return int((trace.objects.kinds()[trace.states.object] == "pedestrian").sum())
+
+
+@pytest.mark.real_data
+def test_a_resumed_run_counts_the_decisions_of_the_parts_it_keeps(real_data, tmp_path):
+    """Each part keeps its chunk's count: a run resumed after losing one part counts what the
+    whole run counted, not only the traces it queried again."""
+    from scenegrep.dataset import QuerySpec
+    from scenegrep.dataset.ingest import ingest
+    from scenegrep.dataset.run import RunOptions, run_query
+
+    recordings = sorted((real_data / "nuscenes_mini_scenarionet").iterdir())[:3]
+    root = tmp_path / "fleet"
+    assert not ingest([str(p) for p in recordings], root, jobs=1, label=False).failed
+    spec = QuerySpec.of("scene", CROSSING_QUERY, unknown_layers="strict", values=False)
+    whole = run_query(root, spec, RunOptions(jobs=3))
+    parts = sorted((root / "runs" / whole.run_id / "parts").glob("*.parquet"))
+    assert len(parts) == 3
+    parts[0].unlink()
+    resumed = run_query(root, spec, RunOptions(jobs=1, resume=True))
+    assert whole.assumed == resumed.assumed == {"crossing": sum(_pedestrian_states_of(p) for p in recordings)}

@@ -8,20 +8,24 @@ Every query file starts with two header lines::
 
 ``Run`` names the query kind (scenario, scene or spre) and its options as ``name=value`` pairs,
 the options of :class:`scenegrep.dataset.queries.QuerySpec` (the command-line options with ``_``
-for ``-``); further comment lines say why. A query is run as ``scenegrep <kind> FILE DATA...``
-with those options, i.e. over files (:func:`scenegrep.dataset.files.query_files`), each recording
-labelled under the query's own unknown-layers choice.
+for ``-``); further comment lines say why. A query means ``scenegrep <kind> FILE DATA...`` with
+those options. The tests run it as ``--dataset`` does, over every input ingested once per
+process and per unknown-layers choice (labelled under the query's own choice, as a query over
+files labels them): the same rows as over files (tests/dataset checks the two modes equal), for
+one reading and labelling of each recording instead of one per query.
 """
 
 from __future__ import annotations
 
+import tempfile
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 from typing import Any
 
-from scenegrep.dataset.files import query_files
+from scenegrep.dataset.ingest import ingest
 from scenegrep.dataset.queries import QuerySpec
+from scenegrep.dataset.run import RunOptions, run_query
 from tests.conftest import REPO, SHARED
 
 LIBRARY = REPO / "examples" / "queries" / "real"
@@ -114,12 +118,45 @@ def query(name: str) -> LibraryQuery:
     raise KeyError(name)
 
 
+INPUTS = (*RECORDINGS, "examples/sample")
+"""Every input the library runs on: the real recordings and the simulated sample."""
+
+
+def input_path(recording: str) -> Path:
+    """The path of an input of :data:`INPUTS` (real_data-relative, or repository-relative)."""
+    return (REPO if recording.startswith("examples/") else SHARED / "real_data") / recording
+
+
+_FOLDER = tempfile.TemporaryDirectory(prefix="scenegrep-library-")
+
+
 @cache
+def dataset(unknown_layers: str) -> Path:
+    """Every input ingested, labelled under the choice ``unknown_layers``, once per process."""
+    root = Path(_FOLDER.name) / unknown_layers
+    report = ingest([str(input_path(r)) for r in INPUTS], root, jobs=1, unknown_layers=unknown_layers)
+    assert not report.failed, report.failed
+    return root
+
+
+@cache
+def _rows_by_input(name: str) -> dict[str, tuple[dict[str, Any], ...]]:
+    """The results-table rows of query ``name`` over every input, by input."""
+    spec = query(name).spec
+    choice = spec.option("unknown_layers")
+    assert choice is not None, f"{name}: the library's queries say how to treat unknown map layers"
+    table = run_query(dataset(choice), spec, RunOptions(jobs=1)).table.to_pylist()
+    found: dict[str, tuple[dict[str, Any], ...]] = {}
+    for recording in INPUTS:
+        path = str(input_path(recording).resolve())
+        found[recording] = tuple(r for r in table if r["source"] == path or r["source"].startswith(path + "/"))
+    return found
+
+
 def rows(name: str, recording: str) -> tuple[dict[str, Any], ...]:
-    """The results-table rows of query ``name`` over one recording (relative to real_data, or a
-    path under the repository such as ``examples/sample``), computed once per process."""
-    path = SHARED / "real_data" / recording if not recording.startswith("examples/") else REPO / recording
-    return tuple(query_files([str(path)], query(name).spec).table.to_pylist())
+    """The results-table rows of query ``name`` over one input of :data:`INPUTS` (computed for
+    every input at once, once per process)."""
+    return _rows_by_input(name)[recording]
 
 
 def matches(name: str, recording: str) -> list[dict[str, Any]]:

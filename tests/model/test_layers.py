@@ -15,12 +15,3 @@ def test_the_report_counts_decisions_per_layer():
     assert choice.report() == (
         "--unknown-layers strict: unknown map layers taken as empty; decisions affected: crossing 3, shoulder 2"
     )
-
-
-def test_decisions_made_elsewhere_are_said_not_counted():
-    choice = UnknownLayers("permissive")
-    choice.count("crossing", 5)
-    assert choice.report(counted=False) == (
-        "--unknown-layers permissive: unknown map layers taken as everywhere; "
-        "decisions made in worker processes are not counted"
-    )

@@ -7,11 +7,15 @@ unknown when not given); the object named
 
 from __future__ import annotations
 
+import dataclasses
 import math
+import textwrap
+from pathlib import Path
 
 import numpy as np
+import pyarrow.feather as feather
 
-from scenegrep.model import LabelTrace, ObjectTable, StateTable
+from scenegrep.model import BehaviourLabels, LabelTrace, ObjectTable, StateTable
 from scenegrep.model.layers import UnknownLayers
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
 from tests.model.maps import synthetic_map
@@ -19,6 +23,8 @@ from tests.model.maps import synthetic_map
 MAP = synthetic_map()
 SIZES = {"Car": (4.5, 2.0), "Pedestrian": (0.75, 0.75), "Truck": (8.0, 2.5), "Cone": (0.4, 0.4)}
 HEADER = "model scenic.domains.driving.model\n"
+AV2 = Path(__file__).parents[2].parent / "shared/real_data/av2/forecasting/0a1e6f0a-1817-4a98-b02e-db8c9327d151"
+"""The AV2 forecasting scenario whose speeds and accelerations the kinematics tests check by hand."""
 
 
 def trace_of(*frames: dict) -> LabelTrace:
@@ -59,3 +65,36 @@ def ahead(x: float, y: float, heading: float, distance: float) -> tuple[float, f
 def right(x: float, y: float, heading: float, distance: float) -> tuple[float, float]:
     """The point ``distance`` metres to the right of (x, y) for a Scenic heading."""
     return x + distance * math.cos(heading), y + distance * math.sin(heading)
+
+
+def av2_ego_velocity(log: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Times (s) and the ego's velocity (vx, vy in m/s, city frame) at each annotation timestamp of
+    an AV2 sensor log: central differences of its city positions (one-sided at the ends), read
+    from the log's feather files, not through scenegrep."""
+    stamps = np.unique(feather.read_table(log / "annotations.feather", columns=["timestamp_ns"])["timestamp_ns"])
+    poses = feather.read_table(log / "city_SE3_egovehicle.feather").to_pandas().set_index("timestamp_ns")
+    t = (stamps - stamps[0]) / 1e9
+    x, y = poses.tx_m.loc[stamps].to_numpy(), poses.ty_m.loc[stamps].to_numpy()
+    return t, np.gradient(x, t), np.gradient(y, t)
+
+
+def drive_stop_go(until: str, objects: str) -> str:
+    """The scenario program of the guard tests (header included): behaviour ``Go`` does ``Drive``
+    until ``until`` holds, then ``Stop``; ``objects`` are its object statements (and requirements)."""
+    behaviours = textwrap.dedent(f"""\
+        behavior Drive():
+            while True:
+                wait
+        behavior Stop():
+            while True:
+                wait
+        behavior Go():
+            do Drive() until {until}
+            do Stop()
+        """)
+    return HEADER + behaviours + objects
+
+
+def all_driving(trace: LabelTrace) -> LabelTrace:
+    """``trace`` with every state labeled ``Drive`` (and none ``Stop``)."""
+    return dataclasses.replace(trace, behaviours=BehaviourLabels.from_sets([{"Drive"}] * len(trace.states)))

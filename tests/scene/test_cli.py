@@ -86,13 +86,14 @@ def test_exit_code_options_and_quiet(files, capsys):
         ("import math\nego = new Car\n", 2, "scenegrep: error: {p}:2:1: imports are not supported"),
         (
             "ego = new Car on sidewalk\n",
-            3,
-            "scenegrep: failed: hand: {p}:2:7: the road map 'synthetic' does not publish",
+            2,
+            "scenegrep: error: {p}:2:7: the road map 'synthetic' does not publish",
         ),
     ],
 )
 def test_errors_are_one_line_with_the_place(files, capsys, text, status, expected):
-    """Errors in the program stop the command (2); one that a trace's map causes fails that trace (3)."""
+    """Errors in the program stop the command (2), and so does one that the map of the lone trace causes
+    (over several traces it fails that trace alone: exit 3)."""
     program = files / "bad.scenic"
     program.write_text(HEADER + text)
     code, _, err = run([program, files / "trace.json", "--map", files / "unknown.parquet"], capsys)
@@ -104,6 +105,6 @@ def test_missing_inputs(files, capsys):
     code, _, err = run([files / "absent.scenic", files / "trace.json"], capsys)
     assert code == 2 and err == [f"scenegrep: error: {files / 'absent.scenic'}: no such file"]
     code, _, err = run([files / "ahead.scenic", files / "trace.json"], capsys)  # no map anywhere: the trace fails
-    assert code == 3 and err[0].startswith("scenegrep: failed: hand: ") and "has no road map" in err[0]
+    assert code == 2 and len(err) == 1 and err[0].startswith("scenegrep: error: ") and "has no road map" in err[0]
     code, _, err = run([files / "ahead.scenic", files / "trace.json", "--tolerance-heading", "-1"], capsys)
     assert code == 2 and "must not be negative" in err[0]

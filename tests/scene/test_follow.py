@@ -17,6 +17,7 @@ across the exit. ``reference_follow`` is Scenic's ``VectorField.followFrom`` wri
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -64,17 +65,28 @@ ANYWHERE = UnknownLayers("permissive")
 GEOMETRY = MapGeometry(MAP)
 
 
-def reference_follow(x: float, y: float, distance, geometry: MapGeometry = GEOMETRY):
-    """Scenic's followFrom: equal Euler steps along the road direction at the current point
-    (for one distance, or element-wise for an array of them)."""
+def reference_walk(
+    x: float, y: float, distance, geometry: MapGeometry = GEOMETRY
+) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Scenic's followFrom step by step: equal Euler steps along the road direction at the current
+    point, one walk per distance (``distance`` one number or an array). Yields, before each step,
+    the walks' positions and which of them take it; last, where they end (none stepping)."""
     d = np.atleast_1d(np.asarray(distance, dtype=float))
     steps = np.maximum(4, np.ceil(d / 5)).astype(int)
     px, py = np.full(len(d), float(x)), np.full(len(d), float(y))
     for k in range(int(steps.max())):
         walking = k < steps
+        yield px, py, walking
         heading = geometry.scenic_headings(FIELD, px[walking], py[walking], None)
         px[walking] -= np.sin(heading) * d[walking] / steps[walking]
         py[walking] += np.cos(heading) * d[walking] / steps[walking]
+    yield px, py, np.zeros(len(d), dtype=bool)
+
+
+def reference_follow(x: float, y: float, distance, geometry: MapGeometry = GEOMETRY):
+    """Where Scenic's followFrom ends (:func:`reference_walk`), for one distance, or element-wise
+    for an array of them."""
+    *_, (px, py, _) = reference_walk(x, y, distance, geometry)
     return (float(px[0]), float(py[0])) if np.ndim(distance) == 0 else (px, py)
 
 
@@ -323,13 +335,10 @@ def test_the_pieces_hold_every_walk_through_intersection_areas(town, maps_dir):
 
 def _steps_between_lanes(geometry: MapGeometry, areas, x: float, y: float, distance: float) -> bool:
     """Whether a step of the reference walk starts in an intersection area but in none of its lanes."""
-    steps = max(4, math.ceil(distance / 5))
-    for _ in range(steps):
-        if shapely.contains_xy(areas, x, y) and not len(geometry.map.lanes_containing(np.array([x]), np.array([y]))[0]):
-            return True
-        heading = geometry.scenic_headings(FIELD, np.array([x]), np.array([y]), None)[0]
-        x, y = x - math.sin(heading) * distance / steps, y + math.cos(heading) * distance / steps
-    return False
+    return any(
+        walking[0] and shapely.contains_xy(areas, px[0], py[0]) and not len(geometry.map.lanes_containing(px, py)[0])
+        for px, py, walking in reference_walk(x, y, distance, geometry)
+    )
 
 
 @pytest.mark.slow

@@ -9,11 +9,8 @@ frames, ``RelativeSpeed(X, Y)`` equals |vX - vY| and ``apparent heading of X fro
 
 from __future__ import annotations
 
-import dataclasses
 import math
-import textwrap
 from functools import cache
-from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -23,7 +20,7 @@ from hypothesis import strategies as st
 from scenic.core.geometry import apparentHeadingAtPoint
 
 from scenegrep.errors import UserError
-from scenegrep.model import BehaviourLabels, LabelTrace, ObjectTable, StateTable
+from scenegrep.model import LabelTrace, ObjectTable, StateTable
 from scenegrep.model.kinematics import finite_difference_velocity
 from scenegrep.model.layers import UnknownLayers
 from scenegrep.scenario import ScenarioOptions, compile_scenario
@@ -33,7 +30,7 @@ from scenegrep.scene import SceneOptions, compile_scene
 from scenegrep.scene.evaluate import Evaluator, Rows
 from scenegrep.scene.geometry import geometry_of
 from scenegrep.scene.match import labels_of
-from tests.scene.frames import HEADER, MAP, matches, trace_of
+from tests.scene.frames import AV2, HEADER, MAP, all_driving, av2_ego_velocity, drive_stop_go, matches, trace_of
 
 MAX_GAP_S = 1.0
 """Neighbouring states of a track farther apart than this (s) are not differenced (the engine's rule)."""
@@ -279,30 +276,15 @@ OVERTAKEN = [  # the ego at 10 m/s; c 10.5 m ahead speeds up, slows down, moves 
 def test_kinematics_in_scenario_guards(guard, expected):
     """Every state is labeled Drive, none Stop: a window of 3 frames matches where the guard that
     would end Drive never holds in it."""
-    program = textwrap.dedent(f"""\
-        behavior Drive():
-            while True:
-                wait
-        behavior Stop():
-            while True:
-                wait
-        behavior Go():
-            do Drive() until {guard}
-            do Stop()
-        ego = new Car with behavior Go()
-        otherCar = new Car with behavior Drive()
-        """)
-    trace = trace_of(*OVERTAKEN)
-    labeled = dataclasses.replace(trace, behaviours=BehaviourLabels.from_sets([{"Drive"}] * len(trace.states)))
-    query = compile_scenario(HEADER + program, "guard.scenic")
+    program = drive_stop_go(guard, "ego = new Car with behavior Go()\notherCar = new Car with behavior Drive()\n")
+    query = compile_scenario(program, "guard.scenic")
     options = ScenarioOptions(find_all=True, unknown_layers=UnknownLayers("permissive"))
-    result = query.match(labeled, 3, MAP, options)
+    result = query.match(all_driving(trace_of(*OVERTAKEN)), 3, MAP, options)
     found = [m.starts.tolist() for m in result.matches if m.correspondence == {"ego": "ego", "otherCar": "c"}]
     assert found == ([expected] if expected else [])
 
 
 # ---------------------------------------------------------------------------- a real recording
-AV2 = Path(__file__).parents[2].parent / "shared/real_data/av2/forecasting/0a1e6f0a-1817-4a98-b02e-db8c9327d151"
 BRAKING_EGO = "ego = new Object in everywhere, facing Range(0, 360) deg\n"
 
 
@@ -356,15 +338,17 @@ def test_relative_speed_on_a_real_recording(recording):
     assert query.match(trace, None, options).frames().tolist() == expected.tolist()
 
 
-def test_accelerations_from_estimated_velocities_are_unknown():
-    """AV2 sensor logs record no velocities: the accelerations, their differences, are unknown too."""
+def test_accelerations_from_estimated_velocities_are_their_differences():
+    """AV2 sensor logs record no velocities: the accelerations are the central differences of the
+    velocities the reader estimated from positions (here recomputed from the raw ego poses)."""
     log = AV2.parents[1] / "sensor" / "7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
     if not log.exists():
         pytest.skip("../shared/real_data is not here")
-    query = compile_scene(HEADER + BRAKING_EGO + "require ego.acceleration.y > 1\n", "accelerating.scenic")
-    with pytest.raises(UserError) as caught:
-        query.match(read_sensor_log(log), None, SceneOptions())
-    assert caught.value.one_line() == (
-        f"{log}: ego.acceleration is unknown: trace '{log.name}' has no acceleration for object 'ego' at frame 0"
-        " (the data records none; the reader's estimates from positions are not labels)"
-    )
+    t, vx, vy = av2_ego_velocity(log)
+    along = (np.gradient(vx, t) * vx + np.gradient(vy, t) * vy) / np.maximum(np.hypot(vx, vy), 1e-9)
+    expected = np.flatnonzero(along < -1.5)  # braking harder than 1.5 m/s² along the motion
+    assert 5 <= len(expected) < len(t) / 2
+    program = BRAKING_EGO + "require (ego.acceleration.x * ego.velocity.x + ego.acceleration.y * ego.velocity.y)"
+    program += " < -1.5 * max(ego.speed, 1e-9)\n"
+    query = compile_scene(HEADER + program, "braking.scenic")
+    assert query.match(read_sensor_log(log), None, SceneOptions()).frames().tolist() == expected.tolist()

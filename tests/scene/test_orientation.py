@@ -147,9 +147,10 @@ def test_cli_error_is_one_line_and_the_choice_is_reported(tmp_path, capsys):
     )
     write_map_parquet(UNORIENTED, tmp_path / "map.parquet")
     args = ["scene", str(tmp_path / "p.scenic"), str(tmp_path / "t.json"), "--map", str(tmp_path / "map.parquet")]
-    assert main(args) == 3  # the trace fails: its map lacks the direction
+    assert main(args) == 2  # the lone trace fails: its map lacks the direction
     err = capsys.readouterr().err.splitlines()
-    assert err[0].startswith("scenegrep: failed: hand: ") and err[0].endswith("--unknown-layers permissive|strict")
+    assert len(err) == 1 and err[0].startswith("scenegrep: error: ")
+    assert err[0].endswith("--unknown-layers permissive|strict")
     assert "p.scenic:3:5: the road map 'synthetic' does not give the direction of its sidewalks" in err[0]
     assert main([*args, "--unknown-layers", "permissive", "-q", "--no-values"]) == 0
     assert capsys.readouterr().err.splitlines()[-1].startswith("scenegrep: --unknown-layers permissive")

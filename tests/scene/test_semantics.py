@@ -10,12 +10,18 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from scenegrep.errors import UserError
 from scenegrep.model.layers import UnknownLayers
 from scenegrep.scene import SceneOptions
-from tests.scene.frames import ahead, matches, right
+from scenegrep.scene.geometry import geometry_of
+from scenegrep.scene.regions import MapRegion
+from tests.scene.frames import MAP, ahead, matches, right
 
 NORTH, SOUTH, EAST, WEST = 0.0, math.pi, -math.pi / 2, math.pi / 2
 EGO = ("Car", 1.75, 20.0, NORTH)  # centred in lane n1
@@ -347,3 +353,20 @@ def test_choice_counts_the_decisions_it_affected():
     frames = ({"ego": ("Car", -3.0, 20.0, NORTH)}, {"ego": ("Car", 0.5, 20.0, NORTH)})
     assert matches("ego = new Car on road, facing 0", *frames, unknown_layers=choice) == [False, True]
     assert choice.decisions == {"shoulder": 1}
+
+
+@settings(max_examples=60)
+@given(st.lists(st.tuples(st.floats(-300, 300), st.floats(-300, 300)), min_size=1, max_size=20))
+def test_the_distance_to_a_map_layer_is_the_distance_to_its_union(points):
+    """``distance from P to R`` for a map layer: Scenic's distance to the region (0 inside), the
+    distance to the union of the layer's polygons."""
+    x, y = np.array(points).T
+    layers = {
+        "lane": list(MAP.lane_polygons),
+        "intersection": [a.polygon for a in MAP.intersections] + list(MAP.lane_polygons[MAP.lane_is_intersection]),
+        "crossing": [a.polygon for a in MAP.crosswalks],
+    }
+    for layer, polygons in layers.items():
+        union = shapely.union_all(polygons)
+        expected = np.full(len(x), np.inf) if union.is_empty else shapely.distance(union, shapely.points(x, y))
+        assert geometry_of(MAP).distances(MapRegion(layer), x, y) == pytest.approx(expected, abs=1e-9)

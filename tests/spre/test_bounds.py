@@ -97,11 +97,11 @@ def test_a_huge_query_is_a_one_line_error(name, capsys):
 
 
 @pytest.mark.parametrize("name", PER_TRACE)
-def test_a_per_trace_limit_is_a_failed_row(name, capsys):
+def test_a_per_trace_limit_is_a_one_line_error_of_the_lone_trace(name, capsys):
     query, message = PER_TRACE[name]
     code, lines, elapsed = _run(["spre", "--space", "topdown", query, TRACE], capsys)
-    assert code == 3 and lines[0].startswith("scenegrep: failed: ") and message in lines[0], lines[:1]
-    assert "<query>:1:1: " in lines[0] and len(lines) == 2 and elapsed < 5
+    assert code == 2 and lines[0].startswith("scenegrep: error: ") and message in lines[0], lines[:1]
+    assert "<query>:1:1: " in lines[0] and len(lines) == 1 and elapsed < 5
 
 
 @pytest.mark.parametrize("name", STREM)
@@ -164,7 +164,7 @@ ru_maxrss would also count the forked test worker's pages from before the exec).
 def test_nested_quantifiers_over_a_real_trace_are_a_bounded_one_line_error(real_data):
     """94 nested quantifiers over every car of a nuScenes scene: before any work, the
     quantifier whose object combinations pass the per-frame limit is named with the frame; a
-    per-trace error, so a failed row (exit 3), in seconds and under 500 MB peak RSS."""
+    per-trace error, of the lone trace given: a user error (exit 2), in seconds and under 500 MB peak RSS."""
     began = time.perf_counter()
     run = subprocess.run(
         [sys.executable, "-c", PEAK_RSS, NESTED, str(real_data / NUSCENES)],
@@ -175,8 +175,8 @@ def test_nested_quantifiers_over_a_real_trace_are_a_bounded_one_line_error(real_
     )
     elapsed = time.perf_counter() - began
     code, rss_mb = map(int, run.stdout.split())
-    failed = [line for line in run.stderr.splitlines() if line.startswith("scenegrep: failed:")]
-    assert code == 3 and len(failed) == 1, run.stderr[:500]
+    failed = [line for line in run.stderr.splitlines() if line.startswith("scenegrep: error:")]
+    assert code == 2 and len(failed) == 1, run.stderr[:500]
     column = 1 + 4 * len("E(x := [:car:]) ") + 1
     assert f"<query>:1:{column}: nested quantifiers make more than {MAX_ROWS_PER_FRAME}" in failed[0]
     assert "(frame " in failed[0] and "Traceback" not in run.stderr

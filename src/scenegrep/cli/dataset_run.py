@@ -7,8 +7,9 @@ window's first and last frame, inclusive), or every row of the results table wit
 (one object per row) or ``--csv``; a failed trace's error and a summary on stderr. Over files,
 each trace's rows are printed as soon as it is done. ``--output FILE`` also writes the table as
 Parquet, which ``show``, ``report`` and ``export`` read. Exit codes: 0 some trace matches, 1 none,
-2 user error, 3 some path or trace failed (the others are done), 130 interrupted (a dataset
-run keeps the results so far; ``--resume`` continues).
+2 user error (one input, a file or recording rather than a folder, whose only trace fails is one,
+as in ``label`` and ``info``), 3 some path or trace failed (the others are done), 130 interrupted
+(a dataset run keeps the results so far; ``--resume`` continues).
 """
 
 from __future__ import annotations
@@ -17,14 +18,14 @@ import argparse
 import json
 import sys
 from collections import Counter
+from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 from typing import Any
 
+from .inputs import is_one_input
 from .layers import report_unknown_layers
-from .main import EXIT_INTERRUPTED, EXIT_SOME_FAILED
-
-NO_MATCH = 1
+from .main import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
 
 
 def add_dataset_arguments(parser: argparse.ArgumentParser) -> None:
@@ -55,12 +56,10 @@ def run_query_command(
     """Run a query over ``paths`` or ``args.dataset``, print its results; returns the exit code."""
     from .. import readers
     from ..dataset import QuerySpec
-    from ..dataset.queries import spec_choice
+    from ..dataset.queries import uses_map
+    from ..model.layers import UnknownLayers
 
     spec = QuerySpec.of(kind, query, origin, **options)
-    choice = None if kind == "spre" else spec_choice(spec)
-    if choice is not None:
-        choice.decisions.clear()  # the choice is shared by the process; count this run's decisions
     if getattr(args, "map", None):
         readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
     printer = RowPrinter(args)
@@ -73,15 +72,15 @@ def run_query_command(
     counts = results.counts()
     if not args.quiet:
         _summary(results, where or (f"; results in {args.output}" if args.output else ""))
-    if choice is not None:
-        report_unknown_layers(choice, counted=not args.dataset)
+    if uses_map(spec):
+        report_unknown_layers(UnknownLayers(spec.option("unknown_layers"), Counter(results.assumed)))
         if not counts["matched"]:
             _nearest_misses(spec, results, args)
     if results.status == "interrupted":
         return EXIT_INTERRUPTED
     if counts["failed"]:
         return EXIT_SOME_FAILED
-    return 0 if counts["matched"] else NO_MATCH
+    return 0 if counts["matched"] else EXIT_NO_MATCH
 
 
 def _over_files(args: argparse.Namespace, spec: Any, paths: list[str], printer: RowPrinter) -> Any:
@@ -91,7 +90,41 @@ def _over_files(args: argparse.Namespace, spec: Any, paths: list[str], printer: 
     reject_dataset_only(args)
     if not paths:
         raise UserError("give DATA (trace files or directories) or --dataset")
-    return query_files(paths, spec, getattr(args, "map", None), printer)
+    if len(paths) > 1 or not is_one_input(paths[0]):
+        return query_files(paths, spec, getattr(args, "map", None), printer)
+    alone = LoneFailure(printer)
+    results = query_files(paths, spec, getattr(args, "map", None), alone)
+    alone.raise_if_alone()
+    return results
+
+
+class LoneFailure:
+    """The rows callback of a query over one input: it holds back the first trace's rows while
+    they are a failure, until another trace shows the input held several (then it passes them on);
+    :meth:`raise_if_alone` makes a failure of the input's only trace the command's error."""
+
+    def __init__(self, printer: Callable[[list[dict[str, Any]]], None]):
+        self.printer = printer
+        self.held: list[dict[str, Any]] | None = None
+        self.seen = False
+
+    def __call__(self, rows: list[dict[str, Any]]) -> None:
+        """Pass one trace's rows on, or hold them (see the class docstring)."""
+        first, self.seen = not self.seen, True
+        if first and rows and all(row["status"] == "failed" for row in rows):
+            self.held = rows
+            return
+        if self.held is not None:
+            self.printer(self.held)
+            self.held = None
+        self.printer(rows)
+
+    def raise_if_alone(self) -> None:
+        """Raise the held failure (the input's only trace failed) as a user error."""
+        from ..errors import UserError
+
+        if self.held is not None:
+            raise UserError(self.held[0]["error"])
 
 
 def _over_dataset(args: argparse.Namespace, spec: Any, paths: list[str], printer: RowPrinter) -> tuple[Any, str]:

@@ -4,7 +4,8 @@ and an unreadable input reported in one line while the others go on.
 A folder of trace files is replaced by the inputs found in it by
 :func:`scenegrep.dataset.ingest.discover` (the query commands' and ``ingest``'s search), so a
 file there that cannot be read is named and the rest are read. One path that is not such a
-folder is read as before: its error is the command's (one line, exit code 2).
+folder is read as before: its error is the command's (one line, exit code 2), as in the query
+commands (:mod:`scenegrep.cli.dataset_run`).
 """
 
 from __future__ import annotations
@@ -38,17 +39,25 @@ def each_input(paths: list[str], work: Callable[[str], None]) -> int:
     return EXIT_SOME_FAILED if failed else 0
 
 
+def is_one_input(path: str) -> bool:
+    """Whether ``path`` is one input (a file, ``-``, a recording directory such as an Argoverse 2
+    log), not a folder of inputs to search."""
+    from ..dataset.ingest import directory_format
+
+    return not Path(path).is_dir() or directory_format(Path(path)) is not None
+
+
 def _expand(paths: list[str]) -> tuple[list[str], list[tuple[str, str]]]:
     """The inputs under ``paths``, in order, and the files found in folders that look like
     inputs but cannot be read (path, one-line error). A path that is not a folder (a file,
     ``-``, an Argoverse 2 log) is kept as given; a folder with no inputs is a user error."""
-    from ..dataset.ingest import directory_format, discover
+    from ..dataset.ingest import discover
     from ..errors import UserError, at
 
     inputs: list[str] = []
     failed: list[tuple[str, str]] = []
     for path in paths:
-        if not Path(path).is_dir() or directory_format(Path(path)) is not None:
+        if is_one_input(path):
             inputs.append(path)
             continue
         sources, bad = discover([path])

@@ -32,9 +32,8 @@ def unknown_layers_of(args: argparse.Namespace) -> Any:
     return UnknownLayers(args.unknown_layers)
 
 
-def report_unknown_layers(choice: Any, counted: bool = True) -> None:
-    """Print the choice and the decisions it affected on stderr (nothing without a choice); when
-    the decisions were made in worker processes (not ``counted`` here), say so instead of a count."""
-    line = choice.report(counted)
+def report_unknown_layers(choice: Any) -> None:
+    """Print the choice and the decisions it affected on stderr (nothing without a choice)."""
+    line = choice.report()
     if line is not None:
         print(f"scenegrep: {line}", file=sys.stderr)

@@ -37,6 +37,7 @@ COMMANDS = (
 )
 """Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
 
+EXIT_NO_MATCH = 1
 EXIT_USER_ERROR = 2
 EXIT_SOME_FAILED = 3
 EXIT_INTERRUPTED = 130

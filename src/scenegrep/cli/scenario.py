@@ -19,9 +19,8 @@ from typing import Any
 
 from .dataset_run import RowPrinter, add_dataset_arguments, reject_dataset_only, run_query_command
 from .layers import report_unknown_layers, unknown_layers_of
+from .main import EXIT_NO_MATCH
 from .scene import add_tolerance_arguments, tolerance_of, tolerance_options
-
-NO_MATCH = 1
 
 
 def add_parser(subparsers: Any) -> None:
@@ -98,4 +97,4 @@ def _run_online(args: argparse.Namespace) -> int:
             printer([{**identity, **row} for row in scenario_rows(result, args.all, args.explain)])
             found |= result.matched
     report_unknown_layers(choice)
-    return 0 if found else NO_MATCH
+    return 0 if found else EXIT_NO_MATCH

@@ -2,7 +2,8 @@
 
 Over files, the dataset engine's query (:mod:`.dataset_run`): one line per match,
 ``NAME:START-END`` (dataset frame indices of the first and last frame), or the results table
-with ``--json``, ``--csv`` or ``--output``; a bad file is a failed row (exit code 3). As STREM
+with ``--json``, ``--csv`` or ``--output``; a bad file is a failed row (exit code 3), or given
+alone a user error (exit code 2). As STREM
 does (``--compat strem``, ``--online``, ``--export``, standard input): each stream searched as it
 is read, ``PATH:START-END`` (``PATH:START..END``, STREM's first index .. last index + 1, with
 ``--compat strem``; no path for standard input), and the first bad input ends the command (exit
@@ -17,8 +18,7 @@ import sys
 from typing import Any
 
 from .dataset_run import add_dataset_arguments, reject_dataset_only, run_query_command
-
-NO_MATCH = 1
+from .main import EXIT_NO_MATCH
 
 
 def add_parser(subparsers: Any) -> None:
@@ -148,4 +148,4 @@ def _run_streams(args: argparse.Namespace) -> int:
             matches = bound.online() if args.online else bound.offline()
             prefix = "" if path == "-" else f"{path}#{trace.name}" if many else path
             found |= _report(matches, prefix, args, options, bound.trace)
-    return 0 if found else NO_MATCH
+    return 0 if found else EXIT_NO_MATCH

@@ -81,6 +81,23 @@ def _connect(path: Path | None, read_only: bool) -> duckdb.DuckDBPyConnection:
             time.sleep(0.05)
 
 
+def within(root: Path, name: str) -> Path | None:
+    """``root / name`` with symbolic links resolved, or None where that lies outside ``root``."""
+    base = root.resolve()
+    path = (base / name).resolve()
+    return path if path.is_relative_to(base) else None
+
+
+def catalog_file(root: Path, name: str) -> Path:
+    """The file a catalog row names (a trace's or a map's Parquet file, relative to the dataset
+    folder ``root``): UserError if it lies outside the folder (a stranger's catalog may name any
+    path)."""
+    path = within(root, name)
+    if path is None:
+        raise UserError(f"the catalog names a file outside the dataset: {name!r}", at(root))
+    return path
+
+
 def _with_trace_id(table: pa.Table, trace_id: str) -> pa.Table:
     return table.add_column(0, "trace_id", pa.array([trace_id] * table.num_rows, pa.string()))
 

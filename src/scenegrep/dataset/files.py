@@ -28,6 +28,7 @@ from .queries import (
     ORDER,
     QuerySpec,
     compiled,
+    decisions_while,
     match_trace,
     pruned_row,
     query_trace,
@@ -47,16 +48,29 @@ def query_files(
 ) -> Results:
     """Run ``spec`` over every trace under ``paths``; ``map_path`` is the road map of traces
     without their own. ``on_rows`` sees each trace's rows (a failed path's or source's row), with
-    every column, as soon as they are ready. The results are ordered as a dataset run's, with its run id."""
+    every column, as soon as they are ready. The results are ordered as a dataset run's, with its
+    run id, and count the decisions the choice for unknown map layers affected, as a run's do."""
     sources, bad = discover(paths)
+    tables, assumed = decisions_while(spec, lambda: _tables(spec, sources, bad, map_path, on_rows))
+    table = pa.concat_tables([results_table([]), *tables]).sort_by(ORDER)
+    return Results(table, run_id_of(spec), query=spec.key(), assumed=assumed)
+
+
+def _tables(
+    spec: QuerySpec,
+    sources: list[Source],
+    bad: list[tuple[str, str]],
+    map_path: str | None,
+    on_rows: RowsCallback | None,
+) -> list[pa.Table]:
+    """Each batch of rows (:func:`_batches`) as a table, shown to ``on_rows`` as it is ready."""
     tables = []
     with TracePlanner(needs_of(spec, compiled(spec))) as planner:
         for batch in _batches(spec, planner, sources, bad, map_path):
             tables.append(results_table(batch))
             if on_rows is not None:
                 on_rows(tables[-1].to_pylist())
-    table = pa.concat_tables([results_table([]), *tables]).sort_by(ORDER)
-    return Results(table, run_id_of(spec), query=spec.key())
+    return tables
 
 
 def read_queried_trace(

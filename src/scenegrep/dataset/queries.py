@@ -23,11 +23,12 @@ or read from a file (:mod:`scenegrep.dataset.files`).
 from __future__ import annotations
 
 import json
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import pyarrow as pa
 
@@ -35,6 +36,8 @@ from ..errors import UserError, failure_text
 from ..model import LabelTrace, RoadMap
 
 KINDS = ("scenario", "scene", "spre")
+
+T = TypeVar("T")
 
 RESULTS_SCHEMA = pa.schema(
     [
@@ -230,8 +233,17 @@ def _spre_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMap
 def spec_choice(spec: QuerySpec) -> Any:
     """The spec's choice for unknown map layers (checked when the spec was made), one object per
     choice and process, so the road-map geometry built for it serves every trace on the same map;
-    its decision counts are the process's (a command's run clears them first)."""
+    its decision counts are the process's (:func:`decisions_while` takes one run's out of them)."""
     return _choice_of(spec.option("unknown_layers"))
+
+
+def decisions_while(spec: QuerySpec, action: Callable[[], T]) -> tuple[T, dict[str, int]]:
+    """``action()``'s result and, per layer, the decisions the spec's choice for unknown map layers
+    counted while it ran (none for a SpRE, which reads no map): this process's part of a run."""
+    counts: Counter[str] = spec_choice(spec).decisions if uses_map(spec) else Counter()
+    before = Counter(counts)
+    result = action()
+    return result, dict(counts - before)
 
 
 @cache
@@ -330,20 +342,34 @@ class TraceTask:
     time_origin_ns: int
 
 
-def run_tasks(work: tuple[QuerySpec, str | None, list[TraceTask]]) -> list[dict[str, Any]]:
+@dataclass(frozen=True)
+class ChunkRows:
+    """What a worker sends back for a chunk of traces: their ``rows`` and, per map layer, the
+    decisions the choice for unknown layers affected (``assumed``), for the run's report."""
+
+    rows: list[dict[str, Any]]
+    assumed: dict[str, int]
+
+
+def run_tasks(work: tuple[QuerySpec, str | None, list[TraceTask]]) -> ChunkRows:
     """Query a chunk of traces (runs in a worker): ``work`` is the spec, a fallback map path for
     traces without one, and the tasks. A trace that fails to load or query gives a 'failed' row."""
     spec, fallback_map, tasks = work
-    rows = []
-    for task in tasks:
-        identity = {
-            "trace_id": task.trace_id,
-            "name": task.name,
-            "source": task.source,
-            "time_origin_ns": task.time_origin_ns,
-        }
-        rows.extend(query_trace(identity, task.file, lambda task=task: _task_rows(spec, task, fallback_map)))
-    return rows
+    rows, assumed = decisions_while(
+        spec, lambda: [row for task in tasks for row in _query_task(spec, task, fallback_map)]
+    )
+    return ChunkRows(rows, assumed)
+
+
+def _query_task(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> list[dict[str, Any]]:
+    """One task's rows (:func:`query_trace`)."""
+    identity = {
+        "trace_id": task.trace_id,
+        "name": task.name,
+        "source": task.source,
+        "time_origin_ns": task.time_origin_ns,
+    }
+    return query_trace(identity, task.file, lambda: _task_rows(spec, task, fallback_map))
 
 
 def _task_rows(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> list[dict[str, Any]]:

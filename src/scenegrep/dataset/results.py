@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from collections.abc import Callable
 from typing import Any, TextIO
@@ -28,13 +28,16 @@ QUERY_KEY = b"scenegrep.query"
 @dataclass(frozen=True)
 class Results:
     """The results of a run: the table, the run's id, its ``status`` ('finished' or
-    'interrupted': then only the traces done so far have rows besides the pruned ones) and its
-    ``query`` (:meth:`QuerySpec.key <scenegrep.dataset.queries.QuerySpec.key>`; "" when unknown)."""
+    'interrupted': then only the traces done so far have rows besides the pruned ones), its
+    ``query`` (:meth:`QuerySpec.key <scenegrep.dataset.queries.QuerySpec.key>`; "" when unknown)
+    and, per map layer, how many decisions of the run the choice for unknown layers affected
+    (``assumed``: for the report on stderr; not kept in results files)."""
 
     table: pa.Table
     run_id: str = ""
     status: str = "finished"
     query: str = ""
+    assumed: dict[str, int] = field(default_factory=dict)
 
     @classmethod
     def read(cls, path: str | Path) -> Results:

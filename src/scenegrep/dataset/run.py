@@ -3,7 +3,9 @@
 A run's identity is a hash of its query and options (``run_id``). Its directory
 ``runs/<run_id>/`` holds ``query.json``, ``parts/`` (one Parquet file per finished chunk of
 traces, each written atomically as the chunk completes) and, at the end, ``results.parquet``;
-the same table goes into the catalog's ``results`` table (``WHERE run_id = ...``). A run
+the same table goes into the catalog's ``results`` table (``WHERE run_id = ...``). Each part's
+metadata keeps the decisions its chunk's worker made under the choice for unknown map layers
+(:data:`ASSUMED_KEY`), so the results' count covers resumed parts too. A run
 stopped by Ctrl-C keeps what is done (status 'interrupted'); one killed outright keeps its
 parts. ``resume`` reuses the parts of a previous run of the same query and queries only the
 traces without one, so the final results equal those of an uninterrupted run.
@@ -16,6 +18,7 @@ import json
 import math
 import shutil
 import sys
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,7 +27,7 @@ from typing import Any
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from .catalog import Catalog
+from .catalog import Catalog, catalog_file
 from .execute import default_jobs, run_all
 from .plan import Plan, needs_of, plan
 from .queries import ORDER, QuerySpec, TraceTask, compiled, pruned_row, results_table, run_tasks
@@ -32,6 +35,9 @@ from .results import RESULTS_FILE, Results
 
 MAX_CHUNK = 64
 """At most this many traces per task: results are saved (and progress shown) per chunk."""
+
+ASSUMED_KEY = b"scenegrep.assumed"
+"""Key of a part's decisions per unknown map layer (a JSON object) in its Parquet metadata."""
 
 
 @dataclass(frozen=True)
@@ -88,13 +94,14 @@ def identity_of(row: dict[str, Any]) -> dict[str, Any]:
 
 
 def _task(root: Path, row: dict[str, Any], maps: dict[str, str]) -> TraceTask:
+    """The task of a catalog ``traces`` row (UserError if the catalog names its files outside the dataset)."""
     map_file = maps.get(row["map_id"]) if row["map_id"] else None
     return TraceTask(
         row["trace_id"],
         row["name"],
         row["source_path"],
-        str(root / row["file"]),
-        None if map_file is None else str(root / map_file),
+        str(catalog_file(root, row["file"])),
+        None if map_file is None else str(catalog_file(root, map_file)),
         row["time_origin_ns"],
     )
 
@@ -122,11 +129,12 @@ def _execute(spec: QuerySpec, todo: list[TraceTask], parts: Path, options: RunOp
     bar = tqdm(total=total, initial=done, unit="trace", file=sys.stderr, disable=not options.progress, leave=False)
     matched = 0
     try:
-        for number, rows in run_all(run_tasks, work, options.jobs, options.engine, options.address):
+        for number, chunk in run_all(run_tasks, work, options.jobs, options.engine, options.address):
             name = hashlib.sha256("\0".join(t.trace_id for t in chunks[number]).encode()).hexdigest()[:16]
+            table = results_table(chunk.rows).replace_schema_metadata({ASSUMED_KEY: json.dumps(chunk.assumed)})
             with atomic_path(parts / f"{name}.parquet") as tmp:
-                pq.write_table(results_table(rows), tmp)
-            matched += len({r["trace_id"] for r in rows if r["status"] == "match"})
+                pq.write_table(table, tmp)
+            matched += len({r["trace_id"] for r in chunk.rows if r["status"] == "match"})
             bar.set_postfix_str(f"{matched} matched", refresh=False)
             bar.update(len(chunks[number]))
     except KeyboardInterrupt:
@@ -136,13 +144,21 @@ def _execute(spec: QuerySpec, todo: list[TraceTask], parts: Path, options: RunOp
     return "finished"
 
 
+def _assumed(parts: list[pa.Table]) -> dict[str, int]:
+    """The decisions per unknown map layer that the parts' metadata records, summed."""
+    total: Counter[str] = Counter()
+    for part in parts:
+        total.update(json.loads((part.schema.metadata or {}).get(ASSUMED_KEY, b"{}")))
+    return dict(total)
+
+
 def _finish(root: Path, spec: QuerySpec, status: str, parts: Path, planned: Plan) -> Results:
     """Gather the parts and the pruned traces into the results; write them out and to the catalog."""
     tables = [pq.read_table(p) for p in sorted(parts.glob("*.parquet"))]
     pruned = [{**identity_of(row), **pruned_row(reason)} for row, reason in planned.pruned]
-    table = pa.concat_tables([results_table(pruned), *tables]).sort_by(ORDER)
+    table = pa.concat_tables([results_table(pruned), *(t.replace_schema_metadata(None) for t in tables)])
     run_id = run_id_of(spec)
-    results = Results(table, run_id, status, spec.key())
+    results = Results(table.sort_by(ORDER), run_id, status, spec.key(), _assumed(tables))
     results.write_parquet(root / "runs" / run_id / RESULTS_FILE)
     with Catalog(root) as catalog:
         catalog.finish_run(run_id, status, table, results.counts())

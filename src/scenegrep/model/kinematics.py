@@ -12,7 +12,8 @@ from .states import StateTable
 
 ESTIMATED_VELOCITY = "velocity_estimated_from"
 """Trace attribute of a reader that fills velocities the data lacks by :func:`with_derived_velocity`
-(its value says from what): queries treat such velocities as unknown, never as labels."""
+(its value says from what): queries read such velocities as the trace's, and name the estimate
+where it is missing (a track's lone frame)."""
 
 
 def track_order(states: StateTable) -> np.ndarray:

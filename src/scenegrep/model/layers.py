@@ -72,14 +72,11 @@ class UnknownLayers:
         if decisions:
             self.decisions[layer] += int(decisions)
 
-    def report(self, counted: bool = True) -> str | None:
-        """The line for stderr when a choice was made (None without one); when the decisions were
-        made elsewhere (worker processes: not ``counted`` here), it says so instead of a count."""
+    def report(self) -> str | None:
+        """The line for stderr when a choice was made (None without one)."""
         if self.mode is None:
             return None
         meaning = "everywhere" if self.everywhere else "empty"
         choice = f"{OPTION} {self.mode}: unknown map layers taken as {meaning}"
-        if not counted:
-            return f"{choice}; decisions made in worker processes are not counted"
         counts = ", ".join(f"{layer} {n}" for layer, n in sorted(self.decisions.items())) or "none"
         return f"{choice}; decisions affected: {counts}"

@@ -9,7 +9,7 @@ of their timestamp: ``city = R_ego · box + t_ego``. Every annotation timestamp 
 frame; frame times are seconds since the first. The ego vehicle becomes object
 ``ego`` (class REGULAR_VEHICLE, size :data:`EGO_SIZE_M`). Velocities come from
 finite differences of positions (the log has none); the trace attribute
-:data:`~scenegrep.model.kinematics.ESTIMATED_VELOCITY` says so, and queries treat them as unknown.
+:data:`~scenegrep.model.kinematics.ESTIMATED_VELOCITY` says so (queries read them, documented).
 """
 
 from __future__ import annotations

@@ -108,7 +108,7 @@ class Labels:
         message = f"{obj}.{name} is unknown: trace {trace.name!r} has no {name} for object {label!r} at frame {frame}"
         estimated = trace.attributes.get(ESTIMATED_VELOCITY)
         if estimated is not None and name != "angularSpeed":
-            message += f" (the data records none; the reader's estimates from {estimated} are not labels)"
+            message += f" (the data records none, and its {estimated} give no estimate without a frame within 1 s)"
         elif name == "acceleration":
             message += " (accelerations are differences of labeled velocities of the track's neighbouring frames)"
         return UserError(message, where)

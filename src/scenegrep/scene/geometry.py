@@ -190,10 +190,8 @@ class MapGeometry:
 
     def _boxes_meet(self, region: Region, x_lo, x_hi, y_lo, y_hi, value: Values) -> np.ndarray:
         n = len(x_lo)
-        if isinstance(region, Everywhere):
-            return np.ones(n, dtype=bool)
-        if isinstance(region, Nowhere):
-            return np.zeros(n, dtype=bool)
+        if (constant := _constant(region, n)) is not None:
+            return constant
         if isinstance(region, MapRegion):
             boxes = shapely.box(x_lo, y_lo, x_hi, y_hi)
             if region.layer == "curb":
@@ -301,10 +299,8 @@ class MapGeometry:
 
     def _contains_boxes(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         n = len(np.atleast_1d(x))
-        if isinstance(region, Everywhere):
-            return np.ones(n, dtype=bool)
-        if isinstance(region, Nowhere):
-            return np.zeros(n, dtype=bool)
+        if (constant := _constant(region, n)) is not None:
+            return constant
         if isinstance(region, Sector):
             return shapes.boxes_in_sectors(x, y, heading, length, width, *(value(t) for t in region.terms()))
         if isinstance(region, Intersection):
@@ -330,10 +326,8 @@ class MapGeometry:
 
     def _boxes_meet_oriented(self, region: Region, x, y, heading, length, width, value: Values) -> np.ndarray:
         n = len(np.atleast_1d(x))
-        if isinstance(region, Everywhere):
-            return np.ones(n, dtype=bool)
-        if isinstance(region, Nowhere):
-            return np.zeros(n, dtype=bool)
+        if (constant := _constant(region, n)) is not None:
+            return constant
         if isinstance(region, Sector):
             return shapes.boxes_meet_sectors(x, y, heading, length, width, *(value(t) for t in region.terms()))
         if isinstance(region, Union):
@@ -361,15 +355,20 @@ class MapGeometry:
         if isinstance(region, (Everywhere, Nowhere)):
             return np.full(len(np.atleast_1d(x)), 0.0 if isinstance(region, Everywhere) else np.inf)
         if isinstance(region, MapRegion):
-            union = self._unions[region.layer]
-            return (
-                np.full(len(np.atleast_1d(x)), np.inf)
-                if union.is_empty
-                else shapely.distance(union, shapely.points(x, y))
-            )
+            return self._layer_distances(region.layer, x, y)
         if isinstance(region, Union) and all(isinstance(p, MapRegion) for p in region.parts):
             return np.min([self._distances(p, x, y) for p in region.parts], axis=0)
         raise UserError(f"the distance to {_describe(region)} is not supported")
+
+    def _layer_distances(self, layer: str, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Distance (m) from each point to a map layer: to its nearest element, found in the layer's
+        R-tree (the distance to the layer's union, without measuring against the whole union)."""
+        distances = np.full(len(np.atleast_1d(x)), np.inf)
+        if len(self._layer_parts[layer]):
+            points = shapely.points(np.atleast_1d(x), np.atleast_1d(y))
+            (rows, _), nearest = self._trees[layer].query_nearest(points, return_distance=True, all_matches=False)
+            distances[rows] = nearest
+        return distances
 
     def unoriented(self, field: Field) -> set[str]:
         """The layers (``sidewalk``, ``crossing``) whose elements' directions ``field`` reads and
@@ -683,6 +682,16 @@ def _segment_distances(start: np.ndarray, end: np.ndarray, px: float, py: float)
         1,
     )
     return np.hypot(start[:, 0] + t * d[:, 0] - px, start[:, 1] + t * d[:, 1] - py)
+
+
+def _constant(region: Region, n: int) -> np.ndarray | None:
+    """The answer for each of ``n`` rows where the region decides it alone: all True everywhere,
+    all False nowhere; None for any other region."""
+    if isinstance(region, Everywhere):
+        return np.ones(n, dtype=bool)
+    if isinstance(region, Nowhere):
+        return np.zeros(n, dtype=bool)
+    return None
 
 
 def _box_polygons(x, y, heading, length, width) -> np.ndarray:

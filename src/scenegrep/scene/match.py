@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import LabelTrace
-from ..model.kinematics import ESTIMATED_VELOCITY
 from ..model.layers import UnknownLayers
 from .decide import Tolerance, decide
 from .dependencies import Group
@@ -128,10 +127,11 @@ def extend(rows: Rows, name: str, offsets: np.ndarray, candidates: np.ndarray) -
 
 
 def labels_of(trace: LabelTrace) -> Labels:
-    """The label columns the scene query reads: velocities only where the data records them (not
-    those a reader estimated), and no angular speeds (no data format scenegrep reads has them)."""
+    """The label columns the scene query reads: velocities as the trace holds them (recorded, or
+    estimated from positions by a reader whose data records none: the trace attribute
+    :data:`~scenegrep.model.kinematics.ESTIMATED_VELOCITY` says so), and no angular speeds (no
+    data format scenegrep reads has them)."""
     states = trace.states
-    recorded = ESTIMATED_VELOCITY not in trace.attributes
     return Labels(
         states.x,
         states.y,
@@ -139,9 +139,9 @@ def labels_of(trace: LabelTrace) -> Labels:
         states.length,
         states.width,
         dict(trace.attributes),
-        vx=states.vx if recorded else None,
-        vy=states.vy if recorded else None,
-        speed=states.speed() if recorded else None,
+        vx=states.vx,
+        vy=states.vy,
+        speed=states.speed(),
         trace=trace,
     )
 

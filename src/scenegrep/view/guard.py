@@ -21,6 +21,8 @@ from email.message import Message
 from http import HTTPStatus
 from pathlib import Path
 
+from ..dataset.catalog import within
+
 MAX_BODY = 1 << 20
 """The largest request body accepted, in bytes."""
 
@@ -81,9 +83,8 @@ def dataset_file(root: Path, value: object, option: str) -> str:
     regular file inside the dataset folder at ``root`` (symbolic links resolved), returned as given."""
     if not isinstance(value, str):
         raise Refused(HTTPStatus.BAD_REQUEST, f"option {option!r} must name a file inside the dataset")
-    base = root.resolve()
-    target = (base / value).resolve()
-    if Path(value).is_absolute() or not target.is_relative_to(base) or not target.is_file():
+    target = within(root, value)
+    if Path(value).is_absolute() or target is None or not target.is_file():
         raise Refused(HTTPStatus.BAD_REQUEST, f"option {option!r} must name a file inside the dataset: {value!r}")
     return value
 

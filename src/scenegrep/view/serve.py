@@ -30,6 +30,7 @@ from typing import Any
 from urllib.parse import parse_qs, quote, unquote, urlsplit
 
 from ..dataset import Dataset
+from ..dataset.catalog import within
 from ..dataset.queries import OPTIONS, QuerySpec
 from ..dataset.results import RESULTS_FILE, Results
 from ..errors import UserError
@@ -158,9 +159,15 @@ class Handler(BaseHTTPRequestHandler):
         return answer
 
     def _results(self, run_id: str) -> Results:
-        folder = self.server.dataset.path / "runs" / Path(run_id).name
-        if not run_id or not (folder / RESULTS_FILE).is_file():
+        """The results of the run ``run_id``: a run the catalog records, whose folder is a plain
+        name under ``runs/`` (no other file of the dataset, or outside it, is read for a name)."""
+        dataset = self.server.dataset
+        recorded = dataset.sql("SELECT count(*) AS n FROM runs WHERE run_id = ?", [run_id])["n"][0].as_py()
+        folder = within(dataset.path / "runs", run_id) if Path(run_id).name == run_id else None
+        if not recorded or folder is None or folder.parent != (dataset.path / "runs").resolve():
             raise UserError(f"the dataset has no run {run_id!r}")
+        if not (folder / RESULTS_FILE).is_file():
+            raise UserError(f"the run {run_id!r} has no results yet")
         return Results.read(folder)
 
     def _view(self, trace_id: str, run_id: str) -> str:

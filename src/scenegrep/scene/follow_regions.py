@@ -68,7 +68,6 @@ class StartRegion:
 class _Start:
     """One start segment: first point A, unit direction e (metres)."""
 
-    index: int
     a: np.ndarray
     e: np.ndarray
 
@@ -97,7 +96,7 @@ def start_regions(
         length = float(np.hypot(*delta))
         if length == 0:
             continue
-        seg = _Start(index, np.asarray(start[index], dtype=float), delta / length)
+        seg = _Start(np.asarray(start[index], dtype=float), delta / length)
         hint = shapely.Point(hints[index]) if hints is not None else None
         parts = [(shapely.box(0.0, d0, length, d1), np.zeros(2), 0, steps) for steps, d0, d1 in _distance_parts(lo, hi)]
         stack = _nearest_last(parts, hint)

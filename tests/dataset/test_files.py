@@ -54,28 +54,69 @@ def run(argv: list, capsys) -> tuple[int, list[str], list[str]]:
     return code, out.splitlines(), err.splitlines()
 
 
-@pytest.mark.slow
-@pytest.mark.real_data
-@pytest.mark.parametrize("kind", list(QUERIES))
-def test_files_and_dataset_give_the_same_results_table(kind, real_data, real_dataset, tmp_path, capsys, monkeypatch):
-    """Over all of ../shared/real_data and examples/sample: equal tables (rows, columns, trace ids,
-    statuses, pruning reasons, windows, correspondences), with matches, in both modes."""
-    monkeypatch.chdir(REPO)
-    files, dataset = tmp_path / "files.parquet", tmp_path / "dataset.parquet"
+def same_tables(argv: list, paths: list, dataset: Path, folder: Path) -> Results:
+    """The results of a query (``argv``: command, query, options) over the files ``paths`` and over
+    ``dataset``, which ingested them, asserted equal (rows, columns, trace ids, statuses, pruning
+    reasons, windows, correspondences, run id, query); outputs go to ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    files, dataset_results = folder / "files.parquet", folder / "dataset.parquet"
+    command, query, *options = argv
     started = time.perf_counter()
-    command, query, *options = QUERIES[kind]
-    over_files = main([command, query, str(real_data), str(SAMPLE), *options, "--output", str(files), "-q"])
+    over_files = main([str(a) for a in [command, query, *paths, *options, "--output", files, "-q"]])
     middle = time.perf_counter()
-    over_dataset = main([*QUERIES[kind], "--dataset", str(real_dataset), "--output", str(dataset), "-q"])
+    over_dataset = main([str(a) for a in [*argv, "--dataset", dataset, "--output", dataset_results, "-q"]])
     ended = time.perf_counter()
-    a, b = Results.read(files), Results.read(dataset)
+    a, b = Results.read(files), Results.read(dataset_results)
     assert over_files == over_dataset == 0
     assert a.table.column_names == b.table.column_names
     assert a.table.to_pylist() == b.table.to_pylist()
     assert a.run_id == b.run_id and a.query == b.query
-    counts = a.counts()
+    print(f"{a.table.num_rows} rows, {a.counts()}; files {middle - started:.1f} s, dataset {ended - middle:.1f} s")
+    return a
+
+
+@pytest.mark.slow
+@pytest.mark.real_data
+@pytest.mark.parametrize("kind", list(QUERIES))
+def test_files_and_dataset_give_the_same_results_table(kind, real_data, real_dataset, tmp_path, capsys, monkeypatch):
+    """Over all of ../shared/real_data and examples/sample: equal tables, with matches, in both modes."""
+    monkeypatch.chdir(REPO)
+    counts = same_tables(QUERIES[kind], [real_data, SAMPLE], real_dataset, tmp_path).counts()
     assert counts["traces"] == 62 and counts["matched"] > 0 and counts["failed"] == 0
-    print(f"{kind}: {a.table.num_rows} rows, {counts}; files {middle - started:.1f} s, dataset {ended - middle:.1f} s")
+
+
+CROSSING = """model scenic.simulators.newtonian.driving_model
+ego = new Car with behavior AnyBehavior(), with roadDeviation Range(-180, 180) deg, with regionContainedIn everywhere
+walker = new Pedestrian in everywhere, with behavior CrossBehavior(), with regionContainedIn everywhere
+"""
+"""A pedestrian the labeller labels Cross: nuScenes maps publish no crosswalks, so which of its
+pedestrians are crossing depends on the choice for unknown map layers the labels were made under."""
+
+CROSSING_RECORDINGS = (
+    "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl",
+    "av2/sensor/adcf7d18-0510-35b0-a2fa-b4cea13a6d76",
+)
+
+
+@pytest.mark.slow
+@pytest.mark.real_data
+@pytest.mark.parametrize(("ingested", "queried"), [("strict", "permissive"), ("permissive", "strict")])
+def test_a_dataset_labelled_under_another_choice_gives_the_table_of_files(ingested, queried, real_data, tmp_path):
+    """A scenario query whose choice for unknown map layers is not the ingest's labels the dataset's
+    traces again under its own, as a query over files labels them: equal tables, under the query's
+    choice and under the ingest's, and the two differ (nuScenes' Cross labels changed)."""
+    from scenegrep.dataset.ingest import ingest
+
+    paths = [real_data / name for name in CROSSING_RECORDINGS]
+    dataset = tmp_path / "fleet"
+    assert not ingest([str(p) for p in paths], dataset, jobs=1, unknown_layers=ingested).failed
+    query = tmp_path / "crossing.scenic"
+    query.write_text(CROSSING)
+    argv = ["scenario", query, "--window", "1s", "--tolerance-heading", "0.2", "--tolerance-position", "0.5", "--all"]
+    other = same_tables([*argv, "--unknown-layers", queried], paths, dataset, tmp_path / queried)
+    same = same_tables([*argv, "--unknown-layers", ingested], paths, dataset, tmp_path / ingested)
+    assert other.counts()["matched"] == same.counts()["matched"] == 2
+    assert other.matches.num_rows != same.matches.num_rows
 
 
 @pytest.fixture

@@ -41,3 +41,9 @@ def test_every_query_file_of_the_folder_is_a_query():
 def test_every_query_runs_on_every_recording_and_the_sample(name):
     for recording in (*RECORDINGS, "examples/sample"):
         matches(name, recording)
+
+
+def test_the_library_readme_lists_every_query_with_what_it_finds():
+    readme = (LIBRARY / "README.md").read_text(encoding="utf-8")
+    for found in library():
+        assert f"[`{found.name}`]({found.path.name}) | {found.finds} |" in readme, found.name

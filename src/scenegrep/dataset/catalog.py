@@ -5,12 +5,16 @@ Tables (``trace_id`` joins them; frames are positions 0..F-1 of a trace, times s
 - ``sources(path, format, checksum, traces, ingested_at)``: every ingested input and the
   SHA-256 of its bytes; ``source_errors(path, error, failed_at)``: inputs that failed to ingest.
 - ``traces(trace_id, name, source_path, file, map_id, frames, duration_s, period_s, objects,
-  observations, ego, has_behaviours, has_images, time_origin_ns)``; ``file`` is relative to the
-  dataset directory. ``maps(map_id, file, source_path, format, key)``.
+  observations, ego, has_behaviours, has_images, time_origin_ns, labelled_under)``; ``file`` is
+  relative to the dataset directory; ``labelled_under`` is the choice for unknown map layers ingest
+  labelled the trace under (:mod:`scenegrep.dataset.labelling`: NULL when ingest did not label it;
+  'unknown' in rows of a catalog written before the column, which opening it for writing adds).
+  ``maps(map_id, file, source_path, format, key)``.
 - ``objects(trace_id, object_id, category, kind, first_frame, last_frame, observations)``.
 - ``frame_counts(trace_id, frame, category, kind, layer, count)``: objects (``layer`` 'objects')
   or image boxes ('images') of each class in each frame where there is any.
-- ``labels(trace_id, label, observations, objects)``: behaviour label statistics.
+- ``labels(trace_id, label, observations, objects)``: behaviour label statistics (of the labels
+  the trace file holds; the planner does not read them, see :mod:`scenegrep.dataset.plan`).
 - ``runs(run_id, kind, query, options, status, started_at, finished_at, traces, pruned, matched,
   failed)`` and ``results(run_id, trace_id, ...)``: query runs and their results table (the columns
   of :data:`scenegrep.dataset.queries.RESULTS_SCHEMA`).
@@ -60,6 +64,7 @@ CREATE TABLE IF NOT EXISTS results (
     time_origin_ns BIGINT, explanation VARCHAR, error VARCHAR);
 ALTER TABLE results ADD COLUMN IF NOT EXISTS values VARCHAR;
 ALTER TABLE results ADD COLUMN IF NOT EXISTS objects VARCHAR;
+ALTER TABLE traces ADD COLUMN IF NOT EXISTS labelled_under VARCHAR DEFAULT 'unknown';
 """
 
 PER_TRACE_TABLES = ("objects", "frame_counts", "labels")

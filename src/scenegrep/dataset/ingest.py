@@ -10,7 +10,9 @@ were labelled by another version of the labeller, :data:`~scenegrep.label.LABELL
 atomic per trace (each Parquet file appears whole, by rename, before the catalog commits the trace;
 a source's traces are committed together) and reports bad sources without stopping.
 Traces without behaviour labels are labelled with ``scenegrep label``'s labeller unless
-``label`` is False, so scenario queries need no labelling later.
+``label`` is False, so scenario queries under the same choice for unknown map layers need no
+labelling later; the catalog records the choice each trace was labelled under
+(:mod:`.labelling`), and a query under another choice labels the trace again.
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from ..model.layers import UnknownLayers
 from ..readers.trace_folder import SKIPPED
 from .catalog import Catalog
 from .execute import run_all
+from .labelling import COLUMN, labelled, recorded_choice
 from .statistics import TraceStatistics
 
 COMMIT_EVERY = 16
@@ -208,20 +211,30 @@ def prepare_trace(
     labeller, under the choice ``unknown_layers`` for map layers the map does not publish. Ingest
     and a query over files both read traces this way."""
     road_map = None if trace.map_source is None else readers.read_map(trace.map_source)
-    if label and trace.behaviours is None:
-        from ..label import label_trace
-
-        trace = label_trace(trace, road_map, unknown_layers=unknown_layers).trace
+    if label:
+        trace = labelled(trace, road_map, unknown_layers)
     return trace, road_map
 
 
 def catalog_row(
-    trace: LabelTrace, trace_id: str, source_path: str, file: str, map_id: str | None
+    trace: LabelTrace,
+    trace_id: str,
+    source_path: str,
+    file: str,
+    map_id: str | None,
+    labelled_under: str | None = None,
 ) -> tuple[dict[str, Any], TraceStatistics]:
-    """A trace's ``traces`` row in the catalog and its statistics."""
+    """A trace's ``traces`` row in the catalog and its statistics; ``labelled_under`` is the
+    choice ingest labelled it under (:mod:`.labelling`; None: ingest did not label it)."""
     stats = TraceStatistics.of(trace)
     row = {"trace_id": trace_id, **stats.trace, "source_path": source_path, "file": file, "map_id": map_id}
-    return row, stats
+    return row | {COLUMN: labelled_under}, stats
+
+
+def labelling_choice(trace: LabelTrace, label: bool, choice: UnknownLayers) -> str | None:
+    """The choice ingest labels ``trace`` under, as the catalog records it: None when it does not
+    label it (its labels are its own, or ``label`` is False)."""
+    return recorded_choice(choice.mode) if label and trace.behaviours is None else None
 
 
 def _write_trace(
@@ -230,6 +243,7 @@ def _write_trace(
     from ..writers.trace_parquet import write_map_parquet, write_trace_parquet
 
     root = Path(task.root)
+    recorded = labelling_choice(trace, task.label, choice)
     trace, road_map = prepare_trace(trace, task.label, choice)
     map_id = None
     if road_map is not None:
@@ -242,7 +256,7 @@ def _write_trace(
     trace_id = trace_id_of(task.source.path, trace.name, number)
     file = f"{TRACES_DIR}/{trace_id}.parquet"
     write_trace_parquet(trace, root / file)
-    return catalog_row(trace, trace_id, task.source.path, file, map_id)
+    return catalog_row(trace, trace_id, task.source.path, file, map_id, recorded)
 
 
 def _remove_stale_temporaries(root: Path) -> None:

@@ -12,7 +12,10 @@ A query's :class:`Needs` are necessary conditions read off the compiled query:
   (:func:`scenegrep.spre.requirements.required_classes`) somewhere in the trace.
 
 The conditions are necessary, never sufficient: pruning skips only traces that cannot
-match, and the exact query decides the rest.
+match, and the exact query decides the rest. They read object and class counts only, never the
+catalog's behaviour label statistics (``labels``): those are of the labels ingest made under its
+choice for unknown map layers, and a scenario query under another choice labels the trace again
+(:mod:`.labelling`), so they say nothing of the labels the query reads.
 """
 
 from __future__ import annotations

@@ -332,7 +332,8 @@ def pruned_row(reason: str) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class TraceTask:
-    """One trace to query: its catalog identity, its Parquet file and its map's (absolute paths)."""
+    """One trace to query: its catalog identity, its Parquet file and its map's (absolute paths),
+    and the choice for unknown map layers ingest labelled it under (:mod:`.labelling`)."""
 
     trace_id: str
     name: str
@@ -340,6 +341,7 @@ class TraceTask:
     file: str
     map_file: str | None
     time_origin_ns: int
+    labelled_under: str | None = None
 
 
 @dataclass(frozen=True)
@@ -373,11 +375,19 @@ def _query_task(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> l
 
 
 def _task_rows(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> list[dict[str, Any]]:
+    """One ingested trace's rows; a scenario query reads its labels under the query's choice for
+    unknown map layers, labelled on its own map as a query over files labels it (:func:`.labelling.labelled`)."""
     from .. import readers
+    from .labelling import labelled
 
     trace = readers.read_trace(task.file, "scenegrep-parquet")
-    map_path = (task.map_file or fallback_map) if uses_map(spec) else None
-    return match_trace(spec, trace, readers.read_map(map_path) if map_path else None)
+    if not uses_map(spec):
+        return match_trace(spec, trace, None)
+    own_map = readers.read_map(task.map_file) if task.map_file else None
+    if spec.kind == "scenario":
+        trace = labelled(trace, own_map, spec_choice(spec), task.labelled_under)
+    fallback = readers.read_map(fallback_map) if own_map is None and fallback_map else None
+    return match_trace(spec, trace, own_map if own_map is not None else fallback)
 
 
 def uses_map(spec: QuerySpec) -> bool:

@@ -29,6 +29,7 @@ import pyarrow.parquet as pq
 
 from .catalog import Catalog, catalog_file
 from .execute import default_jobs, run_all
+from .labelling import catalog_value
 from .plan import Plan, needs_of, plan
 from .queries import ORDER, QuerySpec, TraceTask, compiled, pruned_row, results_table, run_tasks
 from .results import RESULTS_FILE, Results
@@ -103,6 +104,7 @@ def _task(root: Path, row: dict[str, Any], maps: dict[str, str]) -> TraceTask:
         str(catalog_file(root, row["file"])),
         None if map_file is None else str(catalog_file(root, map_file)),
         row["time_origin_ns"],
+        catalog_value(row),
     )
 
 

@@ -70,9 +70,10 @@ class ResultsSource:
         return build_view(trace, road_map, self.rows_of(trace_id), self.query, trace_id)
 
     def load(self, trace_id: str) -> tuple[Any, Any]:
-        """One trace of the table and its road map, from the dataset or from its source file."""
+        """One trace of the table and its road map, from the dataset or from its source file; a
+        scenario query's trace with the labels the query read (:mod:`scenegrep.dataset.labelling`)."""
         if self.root is not None:
-            return load_trace(self.root, trace_id)
+            return self._as_queried(trace_id, *load_trace(self.root, trace_id))
         from ..dataset.files import read_queried_trace
 
         rows = self.rows_of(trace_id)
@@ -80,6 +81,15 @@ class ResultsSource:
             raise UserError(f"the results have no trace {trace_id!r}")
         choice = self.query.options.get("unknown_layers") if self.query is not None else None
         return read_queried_trace(rows[0]["source"], trace_id, unknown_layers=choice)
+
+    def _as_queried(self, trace_id: str, trace: Any, road_map: Any) -> tuple[Any, Any]:
+        """A dataset's trace and road map, labelled as the results' scenario query read it."""
+        if self.query is None or self.query.kind != "scenario" or self.root is None:
+            return trace, road_map
+        from ..dataset.labelling import as_queried
+
+        mode = self.query.options.get("unknown_layers")
+        return as_queried(self.root, trace_id, trace, road_map, mode), road_map
 
     def object_kinds(self, trace_ids: set[str]) -> dict[tuple[str, str], str]:
         """(trace_id, object_id) -> canonical kind, for the given traces."""

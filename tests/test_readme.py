@@ -38,5 +38,7 @@ def test_dataset_python_example_runs(real_data, tmp_path, monkeypatch):
     code = re.findall(r"```python\n(.+?)\n```", section, re.S)[0]
     monkeypatch.chdir(REPO)
     fleet = str(tmp_path / "fleet")
-    exec(code.replace('"fleet"', repr(fleet)).replace('"../shared/real_data"', repr(str(real_data))), {})
+    names: dict = {}
+    exec(code.replace('"fleet"', repr(fleet)).replace('"../shared/real_data"', repr(str(real_data))), names)
     assert (tmp_path / "fleet" / "catalog.duckdb").is_file()
+    assert names["report"].failed == []

@@ -38,9 +38,12 @@ class Dataset:
         """The catalog's ``traces`` table."""
         return self.sql("SELECT * FROM traces ORDER BY trace_id")
 
-    def ingest(self, sources: list[str], jobs: int | None = None, label: bool = True) -> IngestReport:
-        """Add (or update) the traces of ``sources``; see :func:`scenegrep.dataset.ingest.ingest`."""
-        return ingest([str(s) for s in sources], self.path, jobs, label)
+    def ingest(
+        self, sources: list[str], jobs: int | None = None, label: bool = True, unknown_layers: str | None = None
+    ) -> IngestReport:
+        """Add (or update) the traces of ``sources``, labelled under the choice ``unknown_layers``
+        for map layers a map does not publish; see :func:`scenegrep.dataset.ingest.ingest`."""
+        return ingest([str(s) for s in sources], self.path, jobs, label, unknown_layers=unknown_layers)
 
     def query(self, kind: str, query: str | Path, *, run: RunOptions | None = None, **options: Any) -> Results:
         """Run a query of ``kind`` ('scenario', 'scene' or 'spre') over every trace. ``query`` is a

@@ -302,14 +302,21 @@ def runs(flags: np.ndarray, length: int) -> list[int]:
 def following(relative: str, seconds: float = 3.0) -> dict[tuple[int, int], list[int]]:
     """(ego, lead) -> window starts in which, at every frame, the lead is in the ego's lanes 0-30 m
     ahead and both move faster than 1 m/s."""
-    r = raw(relative)
     window = window_frames(relative, seconds)
+    out = {pair: runs(flag, window) for pair, flag in following_frames(relative).items()}
+    return {pair: starts for pair, starts in out.items() if starts}
+
+
+@cache
+def following_frames(relative: str) -> dict[tuple[int, int], np.ndarray]:
+    """(ego, lead) -> per frame, whether the lead is in the ego's lanes 0-30 m ahead and both move
+    faster than 1 m/s."""
+    r = raw(relative)
     flags: dict[tuple[int, int], np.ndarray] = defaultdict(lambda: np.zeros(r.n_frames, dtype=bool))
     for f, pairs in lane_ahead_frames(relative).items():
         for e, k in pairs:
             flags[(e, k)][f] = r.speed[f, e] > 1 and r.speed[f, k] > 1
-    out = {pair: runs(flag, window) for pair, flag in flags.items()}
-    return {pair: starts for pair, starts in out.items() if starts}
+    return dict(flags)
 
 
 def passes(relative: str, ref: int, other: int, sides: tuple[str, ...], window: int, moving: bool) -> list[int]:
@@ -369,12 +376,8 @@ def overtaken_on_right_while_followed(relative: str, seconds: float = 4.0) -> di
     within ``seconds``."""
     r = raw(relative)
     window = window_frames(relative, seconds)
-    followed: dict[tuple[int, int], np.ndarray] = defaultdict(lambda: np.zeros(r.n_frames, dtype=bool))
-    for f, pairs in lane_ahead_frames(relative).items():
-        for e, k in pairs:
-            followed[(e, k)][f] = r.speed[f, e] > 1 and r.speed[f, k] > 1
     out = {}
-    for (e, lead), flags in followed.items():
+    for (e, lead), flags in following_frames(relative).items():
         for k in r.vehicles:
             if k in (e, lead):
                 continue

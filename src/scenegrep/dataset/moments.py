@@ -1,0 +1,174 @@
+"""A match as a moment to re-simulate: the labeled objects over the match's window, with their
+paths, for the exporters to Scenic and OpenSCENARIO.
+
+A :class:`Moment` holds, for one match row of a results table, every program object's labeled
+object (its correspondence) and, with ``context`` metres, every other labeled object whose
+centre is within that distance of a corresponded object in some frame of the window. Each
+object's :class:`ObjectPath` lists its observations over the window in frame order: times in
+seconds from the window's first frame, map-frame positions (m), headings (rad, Scenic's
+convention: 0 along +y, counter-clockwise) and its size (m, the median of its observations in
+the window). Objects are ordered: the ego first when the trace has one, then the corresponded
+objects in the correspondence's order, then context objects by label id.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import UserError
+from ..model import LabelTrace
+from ..model.trace import MapSource
+from .results import Results
+
+MAX_CONTEXT_M = 1000.0
+"""The largest ``context`` radius (m) a user may ask for."""
+
+
+@dataclass(frozen=True, eq=False)
+class ObjectPath:
+    """One labeled object over a moment's window (units in the module docstring); ``program_name``
+    is the program object it corresponds to (None for a context object)."""
+
+    label_id: str
+    program_name: str | None
+    category: str
+    length: float
+    width: float
+    height: float
+    times: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    heading: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Moment:
+    """One match (row ``match`` of trace ``trace_name``) as objects over its window of dataset
+    frames ``start_frame``..``end_frame`` (inclusive), starting ``start_time`` s into the trace;
+    ``map_source`` is where the trace's road map is read (None: the trace has none); ``ego`` is the
+    ego's label id when the trace names one."""
+
+    trace_id: str
+    trace_name: str
+    match: int
+    start_frame: int
+    end_frame: int
+    start_time: float
+    map_source: MapSource | None
+    ego: str | None
+    objects: tuple[ObjectPath, ...]
+
+
+def moments(
+    results: Results, load: Callable[[str], LabelTrace], context: float | None = None
+) -> Iterator[Moment]:
+    """The moments of every match row of ``results`` in table order; ``load`` gives a trace by
+    trace id; ``context`` (m, 0..:data:`MAX_CONTEXT_M`) adds nearby labeled objects. UserError for
+    a table whose traces failed or whose rows name objects the trace does not have."""
+    if context is not None and not 0 <= context <= MAX_CONTEXT_M:
+        raise UserError(f"--context {context}: give a radius from 0 to {MAX_CONTEXT_M:g} m")
+    rows = [r for r in results.table.to_pylist() if r["status"] == "match"]
+    loaded: tuple[str, LabelTrace] | None = None
+    for row in rows:
+        if loaded is None or loaded[0] != row["trace_id"]:
+            loaded = (row["trace_id"], load(row["trace_id"]))
+        yield moment_of(loaded[1], row, context)
+
+
+def moment_of(trace: LabelTrace, row: dict[str, Any], context: float | None = None) -> Moment:
+    """The moment of one match row over ``trace`` (see :func:`moments`)."""
+    correspondence = _correspondence(row)
+    positions = _window(trace, row)
+    ids = trace.objects.row_of()
+    missing = sorted(set(correspondence.values()) - set(ids))
+    if missing:
+        raise UserError(f"trace {trace.name} has no object {missing[0]!r} that match {row['match']} names")
+    names = {label: name for name, label in correspondence.items()}
+    chosen = list(dict.fromkeys(([trace.ego] if trace.ego in ids else []) + list(correspondence.values())))
+    in_window = np.isin(trace.states.frame, positions)
+    if context is not None:
+        chosen += _nearby(trace, in_window, [ids[c] for c in chosen], context)
+    objects = tuple(_path(trace, in_window, ids[label], label, names.get(label), positions[0]) for label in chosen)
+    return Moment(
+        trace_id=str(row["trace_id"]),
+        trace_name=str(row["name"]),
+        match=int(row["match"]),
+        start_frame=int(row["start_frame"]),
+        end_frame=int(row["end_frame"]),
+        start_time=float(trace.frame_time[positions[0]]),
+        map_source=trace.map_source,
+        ego=trace.ego if trace.ego in ids else None,
+        objects=objects,
+    )
+
+
+def _correspondence(row: dict[str, Any]) -> dict[str, str]:
+    try:
+        found = json.loads(row["correspondence"] or "{}")
+        return {str(name): str(label) for name, label in found.items()}
+    except (ValueError, AttributeError):
+        raise UserError(f"match {row['match']} of {row['name']}: its correspondence is not scenegrep's") from None
+
+
+def _window(trace: LabelTrace, row: dict[str, Any]) -> np.ndarray:
+    """The frame positions of a row's window (its dataset frame indices ``start_frame``..``end_frame``)."""
+    index = trace.frame_index
+    positions = np.flatnonzero((index >= int(row["start_frame"])) & (index <= int(row["end_frame"])))
+    if not len(positions):
+        raise UserError(
+            f"match {row['match']} of {trace.name}: frames {row['start_frame']}..{row['end_frame']} are not in the trace"
+        )
+    return positions
+
+
+def _nearby(trace: LabelTrace, in_window: np.ndarray, anchors: list[int], radius: float) -> list[str]:
+    """Label ids of the objects besides ``anchors`` whose centre comes within ``radius`` m of an
+    anchor's centre in a frame of the window, sorted."""
+    states = trace.states
+    frame, obj = states.frame[in_window], states.object[in_window]
+    xy = np.stack([states.x[in_window], states.y[in_window]], axis=1)
+    is_anchor = np.isin(obj, anchors)
+    near: set[int] = set()
+    for f in np.unique(frame[is_anchor]).tolist():
+        here = frame == f
+        centres = xy[here & is_anchor]
+        others = here & ~is_anchor
+        if not others.any():
+            continue
+        gaps = np.linalg.norm(xy[others][:, None, :] - centres[None, :, :], axis=2).min(axis=1)
+        near.update(obj[others][gaps <= radius].tolist())
+    return sorted(str(trace.objects.id[o]) for o in near)
+
+
+def _path(
+    trace: LabelTrace, in_window: np.ndarray, row: int, label: str, name: str | None, first: int
+) -> ObjectPath:
+    states = trace.states
+    k = np.flatnonzero(in_window & (states.object == row))
+    if not len(k):
+        raise UserError(f"trace {trace.name}: object {label} is not observed in the match's window")
+    return ObjectPath(
+        label_id=label,
+        program_name=name,
+        category=str(trace.objects.category[row]),
+        length=_median(states.length[k]),
+        width=_median(states.width[k]),
+        height=_median(states.height[k]),
+        times=trace.frame_time[states.frame[k]] - trace.frame_time[first],
+        x=states.x[k].copy(),
+        y=states.y[k].copy(),
+        z=states.z[k].copy(),
+        heading=states.heading[k].copy(),
+    )
+
+
+def _median(values: np.ndarray) -> float:
+    """The median of the finite values (NaN when there are none)."""
+    finite = values[np.isfinite(values)]
+    return float(np.median(finite)) if len(finite) else float("nan")

@@ -65,9 +65,7 @@ class Moment:
     objects: tuple[ObjectPath, ...]
 
 
-def moments(
-    results: Results, load: Callable[[str], LabelTrace], context: float | None = None
-) -> Iterator[Moment]:
+def moments(results: Results, load: Callable[[str], LabelTrace], context: float | None = None) -> Iterator[Moment]:
     """The moments of every match row of ``results`` in table order; ``load`` gives a trace by
     trace id; ``context`` (m, 0..:data:`MAX_CONTEXT_M`) adds nearby labeled objects. UserError for
     a table whose traces failed or whose rows name objects the trace does not have."""
@@ -122,7 +120,8 @@ def _window(trace: LabelTrace, row: dict[str, Any]) -> np.ndarray:
     positions = np.flatnonzero((index >= int(row["start_frame"])) & (index <= int(row["end_frame"])))
     if not len(positions):
         raise UserError(
-            f"match {row['match']} of {trace.name}: frames {row['start_frame']}..{row['end_frame']} are not in the trace"
+            f"match {row['match']} of {trace.name}: frames {row['start_frame']}..{row['end_frame']} "
+            "are not in the trace"
         )
     return positions
 
@@ -146,9 +145,7 @@ def _nearby(trace: LabelTrace, in_window: np.ndarray, anchors: list[int], radius
     return sorted(str(trace.objects.id[o]) for o in near)
 
 
-def _path(
-    trace: LabelTrace, in_window: np.ndarray, row: int, label: str, name: str | None, first: int
-) -> ObjectPath:
+def _path(trace: LabelTrace, in_window: np.ndarray, row: int, label: str, name: str | None, first: int) -> ObjectPath:
     states = trace.states
     k = np.flatnonzero(in_window & (states.object == row))
     if not len(k):

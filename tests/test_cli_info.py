@@ -4,6 +4,7 @@ import json
 import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -65,3 +66,19 @@ def test_usage_errors_and_help():
     assert out.returncode == 2 and out.stderr.count("\n") == 1 and "PATH" in out.stderr
     out = subprocess.run([sys.executable, "-m", "scenegrep", "--help"], capture_output=True, text=True)
     assert out.returncode == 0 and "info" in out.stdout
+
+
+def test_closed_stdout_is_not_a_failed_input():
+    """`scenegrep info MANY | head -1`: the reader leaving stops the command quietly (exit 0); no
+    input is reported as failed because stdout was closed."""
+    sample = sorted(str(p) for p in Path("examples/sample").glob("*.parquet"))
+    process = subprocess.Popen(
+        [sys.executable, "-m", "scenegrep", "info", *sample],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    assert process.stdout.readline().startswith(b"examples/sample/")
+    process.stdout.close()
+    stderr = process.stderr.read().decode()
+    assert process.wait(timeout=60) == 0
+    assert "failed" not in stderr

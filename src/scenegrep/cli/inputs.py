@@ -32,6 +32,8 @@ def each_input(paths: list[str], work: Callable[[str], None]) -> int:
     for path in inputs:
         try:
             work(path)
+        except BrokenPipeError:  # the reader of stdout left (`| head`): stop, nothing failed
+            raise
         except Exception as exc:  # one bad input must not stop the others
             failed.append((path, failure_text(exc, path)))
     for path, error in failed:

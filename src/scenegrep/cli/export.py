@@ -1,11 +1,12 @@
-"""``scenegrep export RESULTS (--mcap OUT.mcap | --refav OUT --prompt TEXT)``: a results table for
-other tools.
+"""``scenegrep export RESULTS (--mcap OUT.mcap | --refav OUT --prompt TEXT | --openscenario DIR)``: a
+results table for other tools.
 
 RESULTS is a results table (Parquet, JSON lines or CSV) or a run directory. ``--mcap`` writes
 its matches as Foxglove events; ``--refav`` writes a RefAV scenario-mining submission
 (:mod:`scenegrep.dataset.refav_export`): RefAV's own pickle when OUT ends in ``.pkl``, the same
-data as JSON (which ``scenegrep evaluate`` reads) when it ends in ``.json``. Exit codes: 0
-written, 2 user error.
+data as JSON (which ``scenegrep evaluate`` reads) when it ends in ``.json``; ``--openscenario``
+writes every match as an OpenSCENARIO 1.3 file in DIR (:mod:`scenegrep.dataset.openscenario_export`).
+Exit codes: 0 written, 2 user error.
 """
 
 from __future__ import annotations
@@ -32,6 +33,13 @@ def add_parser(subparsers: Any) -> None:
     target = parser.add_mutually_exclusive_group(required=True)
     target.add_argument("--mcap", metavar="OUT", help="the MCAP file to write")
     target.add_argument("--refav", metavar="OUT", help="the RefAV submission to write: OUT.pkl (RefAV's) or OUT.json")
+    target.add_argument("--openscenario", metavar="DIR", help="the folder to write each match to as OpenSCENARIO (.xosc)")
+    parser.add_argument(
+        "--context",
+        metavar="R",
+        type=float,
+        help="--openscenario: also every labeled object within R m of a corresponded one (default: none)",
+    )
     parser.add_argument("--prompt", metavar="TEXT", help="--refav: the RefAV prompt the query answers")
     parser.add_argument(
         "--referred",
@@ -39,15 +47,21 @@ def add_parser(subparsers: Any) -> None:
         help="--refav: the program object the prompt refers to (default: the one besides ego)",
     )
     parser.add_argument(
-        "--dataset", metavar="DATASET", help="--refav: the dataset of the results (default: where they lie)"
+        "--dataset",
+        metavar="DATASET",
+        help="--refav, --openscenario: the dataset of the results (default: where they lie)",
     )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.context is not None and args.openscenario is None:
+        raise UserError("--context goes with --openscenario")
     if args.refav is not None:
         return _refav(args)
+    if args.openscenario is not None:
+        return _openscenario(args)
     if args.prompt is not None or args.referred is not None or args.dataset is not None:
         raise UserError("--prompt, --referred and --dataset go with --refav")
     from ..dataset.export import write_mcap_events
@@ -79,4 +93,38 @@ def _refav(args: argparse.Namespace) -> int:
             f"written to {args.refav}",
             file=sys.stderr,
         )
+    return 0
+
+
+def _openscenario(args: argparse.Namespace) -> int:
+    from ..dataset.moments import moments
+    from ..dataset.openscenario_export import write_openscenario
+    from ..view.sources import ResultsSource
+
+    if args.prompt is not None or args.referred is not None:
+        raise UserError("--prompt and --referred go with --refav")
+    source = ResultsSource.open(args.results, args.dataset)
+    summary = write_openscenario(
+        moments(source.results, lambda trace_id: source.load(trace_id)[0], args.context), args.openscenario
+    )
+    if not args.quiet:
+        print(f"scenegrep: {len(summary.files)} matches written as OpenSCENARIO 1.3 to {args.openscenario}", file=sys.stderr)
+        if summary.without_road_network:
+            print(
+                f"scenegrep: {summary.without_road_network} files have no road network: their traces' maps are not "
+                "OpenDRIVE (said in each file's FileHeader description)",
+                file=sys.stderr,
+            )
+        if summary.default_size:
+            print(
+                f"scenegrep: {summary.default_size} objects have no labeled size: written with their category's "
+                "default dimensions",
+                file=sys.stderr,
+            )
+        if summary.without_trajectory:
+            print(
+                f"scenegrep: {summary.without_trajectory} objects are observed at one frame of their window: "
+                "an initial pose, no trajectory",
+                file=sys.stderr,
+            )
     return 0

@@ -33,7 +33,9 @@ def add_parser(subparsers: Any) -> None:
     target = parser.add_mutually_exclusive_group(required=True)
     target.add_argument("--mcap", metavar="OUT", help="the MCAP file to write")
     target.add_argument("--refav", metavar="OUT", help="the RefAV submission to write: OUT.pkl (RefAV's) or OUT.json")
-    target.add_argument("--openscenario", metavar="DIR", help="the folder to write each match to as OpenSCENARIO (.xosc)")
+    target.add_argument(
+        "--openscenario", metavar="DIR", help="the folder to write each match to as OpenSCENARIO (.xosc)"
+    )
     parser.add_argument(
         "--context",
         metavar="R",
@@ -108,7 +110,10 @@ def _openscenario(args: argparse.Namespace) -> int:
         moments(source.results, lambda trace_id: source.load(trace_id)[0], args.context), args.openscenario
     )
     if not args.quiet:
-        print(f"scenegrep: {len(summary.files)} matches written as OpenSCENARIO 1.3 to {args.openscenario}", file=sys.stderr)
+        print(
+            f"scenegrep: {len(summary.files)} matches written as OpenSCENARIO 1.3 to {args.openscenario}",
+            file=sys.stderr,
+        )
         if summary.without_road_network:
             print(
                 f"scenegrep: {summary.without_road_network} files have no road network: their traces' maps are not "

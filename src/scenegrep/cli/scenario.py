@@ -7,18 +7,20 @@ every window start, else the first match per trace. ``--explain`` adds the witne
 furthest frame reached and what failed there. ``--json``, ``--csv`` and ``--output`` give the
 results table (:mod:`.dataset_run`). Traces without behaviour labels are labelled first with
 their own road map, as ``ingest`` labels them. ``--online`` reads scenegrep JSON trace documents
-(one per line) from stdin and reports each match as soon as its window is complete. Exit codes:
+(one per line) or an MCAP stream from stdin, ``--follow FILE`` an MCAP file as it is written
+(:mod:`.live`), and reports each match as soon as its window is complete. Exit codes:
 0 some trace matches, 1 none, 2 error, 3 some trace failed.
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
+from collections.abc import Iterator
 from typing import Any
 
 from .dataset_run import RowPrinter, add_dataset_arguments, reject_dataset_only, run_query_command
 from .layers import report_unknown_layers, unknown_layers_of
+from .live import add_live_arguments, check_live_arguments
 from .main import EXIT_NO_MATCH
 from .scene import add_tolerance_arguments, tolerance_of, tolerance_options
 
@@ -43,7 +45,10 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("--all", action="store_true", help="every correspondence and window, not the first")
     parser.add_argument("--explain", action="store_true", help="explain matches and non-matches")
-    parser.add_argument("--online", action="store_true", help="read trace documents from stdin, frame by frame")
+    parser.add_argument(
+        "--online", action="store_true", help="read trace documents or an MCAP stream from stdin, frame by frame"
+    )
+    add_live_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object per match")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
     add_dataset_arguments(parser)
@@ -53,7 +58,8 @@ def add_parser(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from ..scenic.parser import read_program
 
-    if args.online:
+    check_live_arguments(args)
+    if args.online or args.follow:
         return _run_online(args)
     options = {
         "window": args.window,
@@ -67,17 +73,18 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_online(args: argparse.Namespace) -> int:
-    """``--online``: trace documents from stdin, each match printed as its window completes."""
+    """``--online``: trace documents or MCAP messages from stdin, or ``--follow FILE``; each match
+    printed as its window completes."""
     from .. import readers
     from ..dataset.queries import scenario_rows
     from ..errors import UserError
     from ..label import label_trace
-    from ..readers.trace_json import decode
     from ..scenario import ScenarioOptions, load_scenario, load_vocabulary
     from ..scenario.online import OnlineScenario
+    from .live import report, until_stopped
 
     if args.data or args.dataset:
-        raise UserError("--online reads stdin; give no DATA or --dataset")
+        raise UserError("--online reads stdin or --follow FILE; give no DATA or --dataset")
     reject_dataset_only(args)
     query = load_scenario(args.program, load_vocabulary(args.vocabulary), args.visible_distance)
     road_map = readers.read_map(args.map) if args.map else None
@@ -85,16 +92,34 @@ def _run_online(args: argparse.Namespace) -> int:
     options = ScenarioOptions(tolerance_of(args), args.visible_distance, args.all, unknown_layers=choice)
     online = OnlineScenario(query, args.window, road_map, options)
     printer = RowPrinter(args)
+    source = args.follow or "<stdin>"
+    chunks, latency = _chunks(args)
     found = False
-    for number, line in enumerate(sys.stdin.buffer, start=1):
-        if not line.strip():
-            continue
-        chunk = decode(line, f"<stdin>:{number}", "stdin")
-        if chunk.behaviours is None:
-            chunk = label_trace(chunk, road_map, unknown_layers=choice).trace
-        for result in online.push(chunk):
-            identity = {"trace_id": result.trace.name, "name": result.trace.name, "source": "<stdin>"}
-            printer([{**identity, **row} for row in scenario_rows(result, args.all, args.explain)])
-            found |= result.matched
+    with until_stopped():
+        for chunk in chunks:
+            if chunk.behaviours is None:
+                chunk = label_trace(chunk, road_map, unknown_layers=choice).trace
+            for result in latency.each_match(online.push(chunk)):
+                identity = {"trace_id": result.trace.name, "name": result.trace.name, "source": source}
+                printer([{**identity, **row} for row in scenario_rows(result, args.all, args.explain)])
+                found |= result.matched
     report_unknown_layers(choice)
+    report(latency, args)
     return 0 if found else EXIT_NO_MATCH
+
+
+def _chunks(args: argparse.Namespace) -> tuple[Iterator[Any], Any]:
+    """The frames of the live input (MCAP) or of the JSON trace documents on stdin, and their latency."""
+    import time
+
+    from ..readers.trace_json import decode
+    from .live import Latency, mcap_chunks, standard_input
+
+    if args.follow:
+        return mcap_chunks(args.follow, args)
+    is_mcap, stdin = standard_input()
+    if is_mcap:
+        return mcap_chunks("-", args, stdin)
+    latency = Latency(time.perf_counter)
+    lines = ((number, line) for number, line in enumerate(stdin, start=1) if line.strip())
+    return latency.chunks(decode(line, f"<stdin>:{number}", "stdin") for number, line in lines), latency

@@ -18,6 +18,7 @@ import sys
 from typing import Any
 
 from .dataset_run import add_dataset_arguments, reject_dataset_only, run_query_command
+from .live import add_live_arguments, check_live_arguments
 from .main import EXIT_NO_MATCH
 
 
@@ -49,6 +50,7 @@ def add_parser(subparsers: Any) -> None:
         choices=["image", "topdown"],
         help="search image boxes or top-down object boxes (default: image if the input has any)",
     )
+    add_live_arguments(parser)
     add_dataset_arguments(parser)
     parser.set_defaults(run=run)
 
@@ -112,6 +114,11 @@ def _streams(args: argparse.Namespace) -> bool:
 def run(args: argparse.Namespace) -> int:
     from ..errors import UserError
 
+    check_live_arguments(args)
+    if args.follow:
+        if args.files or args.dataset:
+            raise UserError("--follow FILE reads that file; give no other FILE or --dataset")
+        args.online = True
     if not args.dataset and _streams(args):
         reject_dataset_only(args)
         if args.output or args.csv:
@@ -130,17 +137,18 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_streams(args: argparse.Namespace) -> int:
     from .. import readers
-    from ..readers.strem_json import iter_documents
-    from ..spre import SearchOptions, TraceSearch, compile_query, search_stream
+    from ..spre import SearchOptions, TraceSearch, compile_query
 
     query = compile_query(args.pattern, compat=args.compat == "strem")
     for warning in query.warnings:
         print(f"scenegrep: warning: {warning}", file=sys.stderr)
     options = SearchOptions(args.space, tuple(args.channel) if args.channel else None, max(args.skip, 0))
+    if args.follow:
+        return _run_live(query, args, options)
     found = False
     for path in args.files or ["-"]:
         if path == "-" and args.online:
-            found |= _report(search_stream(query, iter_documents(sys.stdin.buffer), options), "", args, options)
+            found |= _run_live(query, args, options) == 0
             continue
         many = path != "-" and readers.FORMATS[readers.detect_format(path)].many
         for trace in readers.read_traces(path):
@@ -149,3 +157,26 @@ def _run_streams(args: argparse.Namespace) -> int:
             prefix = "" if path == "-" else f"{path}#{trace.name}" if many else path
             found |= _report(matches, prefix, args, options, bound.trace)
     return 0 if found else EXIT_NO_MATCH
+
+
+def _run_live(query: Any, args: argparse.Namespace, options: Any) -> int:
+    """Online matching of a live input: ``--follow FILE``, or standard input (MCAP or STREM JSON)."""
+    import time
+
+    from ..readers.strem_json import iter_documents
+    from ..spre import search_stream
+    from .live import Latency, mcap_chunks, report, standard_input, until_stopped
+
+    if args.follow:
+        chunks, latency = mcap_chunks(args.follow, args)
+    else:
+        is_mcap, stdin = standard_input()
+        if is_mcap:
+            chunks, latency = mcap_chunks("-", args, stdin)
+        else:
+            latency = Latency(time.perf_counter)
+            chunks = latency.chunks(iter_documents(stdin))
+    with until_stopped():
+        _report(latency.each_match(search_stream(query, chunks, options)), args.follow or "", args, options)
+    report(latency, args)
+    return 0 if latency.found else EXIT_NO_MATCH

@@ -1,0 +1,165 @@
+"""Live input of the online commands (``scenario --online``, ``spre --online``): an MCAP stream followed
+as it is written (``--follow FILE``) or read from standard input, decoded into chunks of frames, and
+each frame's latency.
+
+Standard input is an MCAP stream when it starts with MCAP's magic bytes, else the commands' JSON
+documents as before. MCAP messages become frames by :func:`scenegrep.readers.mcap_documents.document_chunks`.
+While a live input is read, SIGTERM stops the command as Ctrl-C does, and either ends it cleanly: what
+was matched stands (exit code 0 or 1), the latency line is printed.
+
+Latency (``--latency``, one line on stderr at the end): for every frame, the time from the read of its
+last message (:attr:`~scenegrep.readers.mcap_follow.MessageStream.arrival`; for JSON documents the read
+of the document) to the end of its processing, that is after its matches were printed and flushed;
+and the same for each match alone. Median and 99th percentile in milliseconds.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import math
+import signal
+import sys
+import time
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from typing import Any, BinaryIO, TypeVar
+
+T = TypeVar("T")
+
+
+def add_live_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--follow``, ``--idle-timeout`` and ``--latency``."""
+    parser.add_argument(
+        "--follow", metavar="FILE", help="follow an MCAP file as it is written, like tail -f (implies --online)"
+    )
+    parser.add_argument(
+        "--idle-timeout",
+        type=float,
+        metavar="S",
+        help="with --follow: stop after S seconds without new bytes (default: at the writer's end, Ctrl-C or SIGTERM)",
+    )
+    parser.add_argument(
+        "--latency", action="store_true", help="print each frame's latency on stderr at the end (median, p99)"
+    )
+
+
+def check_live_arguments(args: argparse.Namespace) -> None:
+    """UserError for ``--idle-timeout`` without ``--follow`` or not a positive number of seconds."""
+    from ..errors import UserError
+
+    if args.idle_timeout is None:
+        return
+    if args.follow is None:
+        raise UserError("--idle-timeout S needs --follow FILE")
+    if not math.isfinite(args.idle_timeout) or args.idle_timeout <= 0:
+        raise UserError(f"--idle-timeout: {args.idle_timeout} is not a positive number of seconds")
+
+
+class Latency:
+    """Latencies of frames and matches (seconds), measured around the iterators it wraps; ``found``:
+    whether any match was handed out."""
+
+    def __init__(self, arrival: Callable[[], float]):
+        self.arrival = arrival
+        self.current = time.perf_counter()
+        self.frames: list[float] = []
+        self.matches: list[float] = []
+        self.found = False
+
+    def chunks(self, chunks: Iterable[Any]) -> Iterator[Any]:
+        """``chunks``; each chunk's frames are timed when the next chunk is asked for."""
+        for chunk in chunks:
+            self.current = self.arrival()
+            yield chunk
+            self.frames.extend([time.perf_counter() - self.current] * chunk.n_frames)
+
+    def each_match(self, matches: Iterable[T]) -> Iterator[T]:
+        """``matches``; each is timed when the next is asked for (after it was printed)."""
+        for match in matches:
+            self.found = True
+            yield match
+            self.matches.append(time.perf_counter() - self.current)
+
+    def line(self) -> str:
+        """``latency: N frames, median X ms, p99 Y ms; M matches, median ..., p99 ...``."""
+        return f"latency: {_stats(self.frames, 'frame', 'frames')}; {_stats(self.matches, 'match', 'matches')}"
+
+
+def _stats(times: list[float], one: str, many: str) -> str:
+    import numpy as np
+
+    count = f"1 {one}" if len(times) == 1 else f"{len(times)} {many}"
+    if not times:
+        return count
+    median, p99 = np.percentile(np.array(times) * 1000, [50, 99])
+    return f"{count}, median {median:.2f} ms, p99 {p99:.2f} ms"
+
+
+class _Replay(io.RawIOBase):
+    """A stream whose first bytes were already read: ``head`` then the rest of ``stream``."""
+
+    def __init__(self, head: bytes, stream: BinaryIO):
+        self.head = head
+        self.stream = stream
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        if self.head:
+            size = min(len(buffer), len(self.head))
+            buffer[:size], self.head = self.head[:size], self.head[size:]
+            return size
+        read = getattr(self.stream, "read1", self.stream.read)
+        data = read(len(buffer))
+        buffer[: len(data)] = data
+        return len(data)
+
+
+def standard_input() -> tuple[bool, BinaryIO]:
+    """Whether standard input is an MCAP stream, and standard input with nothing consumed."""
+    from ..readers.mcap_follow import MAGIC
+
+    stream = sys.stdin.buffer
+    read = getattr(stream, "read1", stream.read)
+    head = b""
+    while len(head) < len(MAGIC) and (part := read(len(MAGIC) - len(head))):
+        head += part
+    return head == MAGIC, io.BufferedReader(_Replay(head, stream))
+
+
+def mcap_chunks(path: str, args: argparse.Namespace, stdin: BinaryIO | None = None) -> tuple[Iterator[Any], Latency]:
+    """The frames of the MCAP stream at ``path`` (``-``: ``stdin``) as chunks, and their latency meter."""
+    from ..readers.mcap_documents import document_chunks
+    from ..readers.mcap_follow import FollowOptions, follow_mcap
+
+    messages = follow_mcap(path, FollowOptions(idle_timeout=args.idle_timeout), stdin)
+    latency = Latency(lambda: messages.arrival)
+    return latency.chunks(document_chunks(messages, _note)), latency
+
+
+def _note(text: str) -> None:
+    print(f"scenegrep: note: {text}", file=sys.stderr, flush=True)
+
+
+def report(latency: Latency, args: argparse.Namespace) -> None:
+    """The latency line on stderr, with ``--latency``."""
+    if args.latency:
+        print(f"scenegrep: {latency.line()}", file=sys.stderr)
+
+
+@contextmanager
+def until_stopped() -> Iterator[None]:
+    """Run the body until it ends, Ctrl-C or SIGTERM; the last two end it as if the input had ended."""
+
+    def stop(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    except KeyboardInterrupt:
+        pass
+    finally:
+        signal.signal(signal.SIGTERM, previous)

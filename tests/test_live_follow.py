@@ -1,0 +1,226 @@
+"""``--follow`` and MCAP on standard input (issue 18, item 3): matches printed as their frames are written.
+
+Acceptance: another process (tests/live_writer.py) writes an MCAP file message by message, each record
+in two writes, while ``scenegrep ... --follow`` reads it; every match line must reach this test within
+100 ms of the last byte of its window's last frame (both times on the system's monotonic clock). The
+follower polls every 10 ms (``POLL_SECONDS``), so 10 ms of the budget go to polling at worst; the rest
+is decoding, the query and the pipe.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+from mcap.writer import CompressionType, Writer
+
+from scenegrep.cli.main import main
+from scenegrep.readers.mcap_documents import STREM_SCHEMA, TRACE_SCHEMA
+from scenegrep.writers.trace_json import trace_document, write_trace_json
+from scenegrep.writers.trace_parquet import write_map_parquet
+
+from .scenario.worked_example import worked_map, worked_trace
+
+FIG1 = "examples/queries/fig1_lane_change.scenic"
+WRITER = Path(__file__).with_name("live_writer.py")
+BUDGET = 0.1
+
+
+def strem_frame(index: int, kind: str) -> dict:
+    """A STREM frame with one ``kind`` box on channel ``cam``."""
+    box = {"type": "@stremf/bbox/aabb", "region": {"center": {"x": 5, "y": 5}, "dimensions": {"w": 2, "h": 2}}}
+    sample = {
+        "type": "@stremf/sample/detection",
+        "channel": "cam",
+        "image": {"path": f"{index}.png", "dimensions": {"width": 10, "height": 10}},
+        "annotations": [{"class": kind, "score": 1.0, "bbox": box}],
+    }
+    return {"index": index, "samples": [sample]}
+
+
+KINDS = ["car", "car", "pedestrian", "bus", "car", "pedestrian", "car", "car", "pedestrian"]
+"""Frames of the SpRE stream: ``[[:car:]][[:pedestrian:]]`` ends at each pedestrian after a car."""
+
+
+def strem_messages() -> list[tuple[str, str, bytes]]:
+    documents = [{"version": "0.2.0", "frames": [strem_frame(k, kind)]} for k, kind in enumerate(KINDS)]
+    return [("/detections", STREM_SCHEMA, json.dumps(document).encode()) for document in documents]
+
+
+def trace_messages() -> list[tuple[str, str, bytes]]:
+    trace = worked_trace()
+    documents = [trace_document(trace.slice_frames(k, k + 1)) for k in range(trace.n_frames)]
+    return [("/trace", TRACE_SCHEMA, json.dumps(document).encode()) for document in documents]
+
+
+def mcap_file(messages: list[tuple[str, str, bytes]], finish: bool = True, noise: bool = False) -> bytes:
+    """An MCAP file (lz4 chunks of a few messages) of the messages, one per 100 ms of log time."""
+    output = io.BytesIO()
+    writer = Writer(output, chunk_size=2000, compression=CompressionType.LZ4)
+    writer.start("", "test")
+    channels: dict[str, int] = {}
+    if noise:
+        channels["/noise"] = writer.register_channel("/noise", "cdr", 0)
+    for k, (topic, schema, data) in enumerate(messages):
+        if topic not in channels:
+            channels[topic] = writer.register_channel(topic, "json", writer.register_schema(schema, "jsonschema", b""))
+        writer.add_message(channels[topic], log_time=k * 10**8, data=data, publish_time=k * 10**8)
+        if noise:
+            writer.add_message(channels["/noise"], log_time=k * 10**8, data=b"\x00", publish_time=k * 10**8)
+    writer.finish() if finish else writer.flush()
+    return output.getvalue()
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("live")
+    write_map_parquet(worked_map(), folder / "map.parquet")
+    write_trace_json(worked_trace(), folder / "table2.json")
+    return folder
+
+
+def follow(folder: Path, name: str, messages, command: list[str], pause: float) -> SimpleNamespace:
+    """Run the writer and ``scenegrep COMMAND --follow`` on ``folder/name``: the writer's time of each
+    message, each output line with its arrival time, and scenegrep's exit code and stderr."""
+    plan = folder / f"{name}.json"
+    entries = [
+        {"topic": topic, "schema": schema, "encoding": "json", "schema_data": "", "log_time": k * 10**8}
+        | {"data": base64.b64encode(data).decode()}
+        for k, (topic, schema, data) in enumerate(messages)
+    ]
+    plan.write_text(json.dumps({"pause": pause, "messages": entries}))
+    target = folder / f"{name}.mcap"
+    writer = subprocess.Popen(
+        [sys.executable, str(WRITER), str(target), str(plan)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True
+    )
+    assert writer.stdout.readline().strip() == "ready"
+    command = [sys.executable, "-m", "scenegrep", *command, "--follow", str(target), "--latency", "--idle-timeout", "5"]
+    scenegrep = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    lines: list[tuple[str, float]] = []
+
+    def read() -> None:
+        for line in scenegrep.stdout:
+            lines.append((line.rstrip("\n"), time.monotonic()))
+
+    reader = threading.Thread(target=read)
+    reader.start()
+    wait_until_open(scenegrep.pid, target)
+    writer.stdin.write("go\n")
+    writer.stdin.flush()
+    written = [float(line.split()[1]) for line in writer.stdout if line.strip() != "done"]
+    assert writer.wait(10) == 0
+    code = scenegrep.wait(10)
+    reader.join()
+    return SimpleNamespace(written=written, lines=lines, code=code, err=scenegrep.stderr.read())
+
+
+def wait_until_open(pid: int, path: Path) -> None:
+    """Until process ``pid`` has ``path`` open: it has loaded its query and reads the file."""
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline:
+        try:
+            if any(Path(f"/proc/{pid}/fd/{fd}").resolve() == path.resolve() for fd in os.listdir(f"/proc/{pid}/fd")):
+                return
+        except OSError:
+            pass
+        time.sleep(0.01)
+    raise AssertionError("scenegrep never opened the followed file")
+
+
+def assert_in_time(run: SimpleNamespace, last_frame) -> None:
+    """Every line arrived after, and within the budget of, the writing of its last frame's message."""
+    assert run.lines
+    for line, arrival in run.lines:
+        written = run.written[last_frame(line)]
+        assert written < arrival < written + BUDGET, (line, arrival - written)
+
+
+@pytest.mark.slow
+def test_scenario_follow_prints_each_window_within_100ms_of_its_last_frame(files, capsys):
+    main(["scenario", FIG1, str(files / "table2.json"), "--window", "3", "--map", str(files / "map.parquet"), "--all"])
+    offline = capsys.readouterr().out.splitlines()
+    args = ["scenario", FIG1, "--window", "3", "--map", str(files / "map.parquet"), "--all"]
+    run = follow(files, "scenario", trace_messages(), args, pause=0.15)
+    assert run.code == 0, run.err
+    assert [line for line, _ in run.lines] == offline and len(offline) == 3
+    assert_in_time(run, lambda line: int(line.split()[0].rsplit("-", 1)[1]))
+    assert "scenegrep: latency: 5 frames, median " in run.err and "; 3 matches, median " in run.err
+
+
+def test_spre_follow_prints_each_match_within_100ms_of_its_last_frame(files):
+    run = follow(files, "spre", strem_messages(), ["spre", "[[:car:]][[:pedestrian:]]"], pause=0.1)
+    path = str(files / "spre.mcap")
+    ends = [k for k, kind in enumerate(KINDS) if kind == "pedestrian" and KINDS[k - 1] == "car"]
+    assert run.code == 0, run.err
+    assert [line for line, _ in run.lines] == [f"{path}:{k - 1}-{k}" for k in ends]
+    assert_in_time(run, lambda line: int(line.rsplit("-", 1)[1]))
+    assert f"latency: {len(KINDS)} frames" in run.err and f"; {len(ends)} matches" in run.err
+
+
+def test_sigterm_ends_following_cleanly(files):
+    """A writer that never finishes: SIGTERM stops the follower, which keeps its matches and exit code."""
+    target = files / "unfinished.mcap"
+    target.write_bytes(mcap_file(strem_messages(), finish=False))
+    command = [sys.executable, "-m", "scenegrep", "spre", "[[:car:]][[:pedestrian:]]", "--follow", str(target)]
+    process = subprocess.Popen([*command, "--latency"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = process.stdout.readline()
+    assert first.strip() == f"{target}:1-2"
+    time.sleep(0.1)
+    process.send_signal(signal.SIGTERM)
+    out, err = process.communicate(timeout=10)
+    assert process.returncode == 0 and "Traceback" not in err
+    assert err.startswith("scenegrep: latency: ")
+
+
+def stdin_run(monkeypatch, capsys, data: bytes, args: list[str]) -> tuple[int, list[str], str]:
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(data)))
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out.splitlines(), err
+
+
+def test_mcap_on_standard_input_with_other_topics_noted(monkeypatch, capsys, files):
+    data = mcap_file(strem_messages(), noise=True)
+    code, lines, err = stdin_run(monkeypatch, capsys, data, ["spre", "--online", "[[:car:]][[:pedestrian:]]"])
+    assert (code, lines) == (0, ["1-2", "4-5", "7-8"])
+    assert err.count("note: skipping topic /noise (no schema, cdr encoding)") == 1
+    data = mcap_file(trace_messages())
+    args = ["scenario", FIG1, "--online", "--window", "3", "--map", str(files / "map.parquet")]
+    code, lines, _ = stdin_run(monkeypatch, capsys, data, args)
+    assert code == 0 and [line.split()[0] for line in lines] == ["table2:0-2", "table2:1-3", "table2:2-4"]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["spre", "x", "--idle-timeout", "2"], "--idle-timeout S needs --follow FILE"),
+        (["spre", "x", "--follow", "F", "--idle-timeout", "nan"], "nan is not a positive number of seconds"),
+        (["spre", "x", "--follow", "F", "--idle-timeout", "0"], "0.0 is not a positive number of seconds"),
+        (["spre", "x", "other.json", "--follow", "F"], "give no other FILE"),
+        (["scenario", FIG1, "other.json", "--window", "3", "--follow", "F"], "give no DATA"),
+        (["spre", "[[:car:]]", "--follow", "{missing}"], "missing.mcap: cannot read: No such file"),
+        (["spre", "[[:car:]]", "--follow", "{table2}"], "table2.json: not an MCAP stream"),
+        (["scenario", FIG1, "--window", "3", "--follow", "{table2}"], "table2.json: not an MCAP stream"),
+    ],
+)
+def test_bad_live_options_and_inputs_are_one_line_errors(files, capsys, args, message):
+    paths = {"missing": files / "missing.mcap", "table2": files / "table2.json"}
+    code = main([arg.format(**paths) for arg in args])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("scenegrep: error: ") and err.count("\n") == 1 and message in err
+
+
+def test_a_bad_document_in_a_message_names_its_topic_and_log_time(monkeypatch, capsys):
+    messages = strem_messages()[:3] + [("/detections", STREM_SCHEMA, b'{"version": "0.2.0", "frames": [{')]
+    code, lines, err = stdin_run(monkeypatch, capsys, mcap_file(messages), ["spre", "--online", "[[:car:]]"])
+    assert code == 2 and lines == ["0-0", "1-1"] and err.startswith("scenegrep: error: /detections @ 300000000 ns")

@@ -231,3 +231,15 @@ def test_a_record_over_a_chosen_limit_is_refused(monkeypatch):
 def test_a_missing_file_is_a_user_error(tmp_path):
     with pytest.raises(UserError, match=r"nothing\.mcap: cannot read: No such file"):
         list(follow_mcap(tmp_path / "nothing.mcap", QUICK))
+
+
+def test_a_followed_file_that_shrinks_is_an_error(tmp_path):
+    data = mcap_bytes(count=6, compression="unchunked")
+    last_message = max(end for end, opcode in record_ends(data).items() if opcode == 0x05)
+    path = tmp_path / "rotated.mcap"
+    path.write_bytes(data[:last_message])
+    stream = iter(follow_mcap(path, QUICK))
+    next(stream)
+    path.write_bytes(data[:100])
+    with pytest.raises(UserError, match=r"rotated\.mcap: the file shrank to fewer than the \d+ bytes read"):
+        list(stream)

@@ -13,7 +13,7 @@ live writer that wants each message seen at once writes unchunked, as ``ros2 bag
   was read) or a Footer; at the end of standard input; or, following a file, after ``idle_timeout``
   seconds without growth (``None``: wait for ever; Ctrl-C or SIGTERM then stop the caller). Input that
   ends inside a record is an error (a truncated stream), one that ends between records is not (a
-  writer that was stopped before its summary).
+  writer that was stopped before its summary). A followed file that shrinks is an error.
 * Memory is bounded: one record's bytes at a time (plus one read block), a chunk's decompressed
   records, and the schemas and channels seen. A record (or a chunk's uncompressed data) longer than
   ``max_record`` bytes is refused before it is read, so a corrupt length cannot exhaust memory.
@@ -28,6 +28,7 @@ out was read: the start of a frame's online latency.
 from __future__ import annotations
 
 import io
+import os
 import struct
 import sys
 import time
@@ -83,19 +84,24 @@ class _Source:
     """Bytes as they arrive: :meth:`read` returns some bytes, ``b""`` (nothing yet: ask again) or
     ``None`` (the input ended)."""
 
-    def __init__(self, stream: BinaryIO, options: FollowOptions, follow: bool):
+    def __init__(self, stream: BinaryIO, options: FollowOptions, follow: bool, name: str):
         self.stream = stream
         self.options = options
         self.follow = follow
+        self.name = name
         self.grown = time.monotonic()
+        self.position = 0
 
     def read(self, size: int) -> bytes | None:
         data = self.stream.read(size) if self.follow else self.stream.read1(size)  # type: ignore[attr-defined]
         if data:
             self.grown = time.monotonic()
+            self.position += len(data)
             return data
         if not self.follow:
             return None
+        if os.fstat(self.stream.fileno()).st_size < self.position:
+            raise UserError(f"the file shrank to fewer than the {self.position} bytes read (truncated?)", at(self.name))
         idle = self.options.idle_timeout
         if idle is not None and time.monotonic() - self.grown >= idle:
             return None
@@ -117,11 +123,11 @@ class MessageStream:
 
     def __iter__(self) -> Iterator[RawMessage]:
         if self.path == "-":
-            yield from self._messages(_Source(self.stdin or sys.stdin.buffer, self.options, follow=False))
+            yield from self._messages(_Source(self.stdin or sys.stdin.buffer, self.options, False, self.name))
             return
         try:
             with open(self.path, "rb", buffering=0) as stream:
-                yield from self._messages(_Source(stream, self.options, follow=True))
+                yield from self._messages(_Source(stream, self.options, True, self.name))
         except OSError as exc:
             raise UserError(f"cannot read: {exc.strerror}", at(self.path)) from None
 

@@ -6,6 +6,7 @@ back with plain XML parsing its entities, initial poses and trajectory vertices 
 from __future__ import annotations
 
 import datetime as dt
+import functools
 import math
 import os
 import tempfile
@@ -13,6 +14,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
+import pyarrow.parquet as pq
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -252,6 +254,9 @@ def test_the_road_file_is_relative_to_the_output_file_and_output_is_deterministi
     assert (first.parent / road).resolve() == town.resolve()
     again = ox.write_openscenario([shown], tmp_path / "c", CREATED).files[0]
     assert again.read_bytes() == first.read_bytes().replace(road.encode(), read_back(again)["road"].encode())
+    (tmp_path / "link").symlink_to(tmp_path / "a" / "b")  # a folder reached through a link: ".." is physical
+    linked = ox.write_openscenario([shown], tmp_path / "link", CREATED).files[0]
+    assert (linked.parent / read_back(linked)["road"]).resolve() == town.resolve()
 
 
 FINITE = st.floats(-1e5, 1e5, allow_nan=False)
@@ -325,6 +330,28 @@ def export(results: Path, out: Path, context: float | None, capsys) -> tuple[lis
     return list(moments(source.results, lambda trace_id: source.load(trace_id)[0], context)), capsys.readouterr().err
 
 
+@functools.lru_cache(maxsize=8)
+def raw_states(source: str) -> list[dict]:
+    table = pq.read_table(source, columns=["kind", "frame", "time", "object", "x", "y", "heading"])
+    return [r for r in table.to_pylist() if r["kind"] == "state"]
+
+
+def assert_raw_states(back: dict, source: str, start: int, end: int) -> None:
+    """The file's poses and vertices are the raw Parquet rows of each entity's label over frames
+    ``start..end`` (read with pyarrow, not scenegrep): time from the window's first frame, x, y
+    and yaw = heading + pi/2."""
+    rows = [r for r in raw_states(source) if start <= r["frame"] <= end]
+    first = min(r["time"] for r in rows)
+    for entity in back["entities"].values():
+        mine = [r for r in rows if r["object"] == entity["props"]["label_id"]]
+        want = [(r["time"] - first, r["x"], r["y"], r["heading"] + math.pi / 2) for r in mine]
+        got = entity["vertices"] or [(want[0][0], *entity["init"][:2], entity["init"][3])]
+        assert len(got) == len(want)
+        for g, w in zip(got, want, strict=True):
+            assert all(same(a, b) for a, b in zip((g[0], g[1], g[2]), w[:3], strict=True))
+            assert same(g[-1], w[3], angle=True)
+
+
 def test_sample_scene_and_scenario_matches_reference_the_opendrive_map(sample_results, tmp_path, capsys):
     town = (REPO / "examples" / "maps" / "Town06.xodr").resolve()
     for name, results in sample_results.items():
@@ -332,10 +359,12 @@ def test_sample_scene_and_scenario_matches_reference_the_opendrive_map(sample_re
         shown, err = export(results, out, 30.0, capsys)
         assert shown and f"{len(shown)} matches written as OpenSCENARIO 1.3" in err
         assert sorted(out.iterdir()) == sorted(out / ox.file_name(m) for m in shown)
+        sources = {(r["trace_id"], r["match"]): r["source"] for r in pq.read_table(results).to_pylist()}
         for m in shown:
             back = assert_matches_moment(out / ox.file_name(m), m)
             assert (out / back["road"]).resolve() == town
             assert "no road network" not in back["header"]["description"]
+            assert_raw_states(back, sources[m.trace_id, m.match], m.start_frame, m.end_frame)
     assert any(len(o.times) == 30 for o in shown[0].objects)  # the scenario's 3 s window: 30 vertices
 
 
@@ -361,6 +390,7 @@ def test_cli_errors(sample_results, tmp_path, capsys):
     for argv, message in (
         (["--mcap", "m.mcap", "--context", "3"], "--context goes with --openscenario"),
         (["--openscenario", str(tmp_path / "file")], "not a directory"),
+        (["--openscenario", ""], "--openscenario: give the folder to write to"),
         (["--openscenario", str(tmp_path / "d"), "--prompt", "p"], "--prompt and --referred go with --refav"),
         (["--openscenario", str(tmp_path / "d"), "--mcap", "m"], "not allowed with argument"),
         (["--openscenario", str(tmp_path / "d"), "--context", "-1"], "--context -1.0: give a radius from 0"),

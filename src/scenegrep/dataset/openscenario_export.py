@@ -160,6 +160,8 @@ def write_openscenario(
     """Write every moment as ``out_dir/<file_name>`` (atomically), each after it validated
     against the XSD; UserError, with nothing more written, at the first file that does not.
     ``created`` is the FileHeader date (default: now, the same for every file)."""
+    if not str(out_dir).strip():
+        raise UserError("--openscenario: give the folder to write to")
     folder = Path(out_dir)
     if folder.exists() and not folder.is_dir():
         raise UserError(f"--openscenario {out_dir}: not a directory")
@@ -267,9 +269,9 @@ def _road_network(xosc: Any, moment: Moment, target: Path) -> tuple[Any, str | N
         return xosc.RoadNetwork(), (
             f"no road network: the trace's map is {source.format}, not OpenDRIVE (scenegrep converts no maps)"
         )
-    path = Path(source.path).absolute()
+    path = Path(source.path).resolve()
     try:
-        reference = Path(os.path.relpath(path, target.parent.absolute())).as_posix()
+        reference = Path(os.path.relpath(path, target.parent.resolve())).as_posix()
     except ValueError:
         reference = path.as_posix()
     return xosc.RoadNetwork(roadfile=_xml_text(reference)), None

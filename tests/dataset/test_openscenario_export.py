@@ -199,13 +199,15 @@ def moment(*objects, trace_id="t-1", name="t", map_source=None, match=0) -> Mome
 def test_partly_observed_objects_start_at_their_first_observation_and_nan_sizes_get_defaults(tmp_path):
     late = path("late", "PEDESTRIAN", times=[0.2, 0.3, 0.5], x=[7.0, 7.5, 8.0], size=(np.nan, np.nan, 1.8))
     once = path("once", "BOLLARD", times=[0.4], x=[3.0])
-    shown = moment(path("ego", program="ego"), late, once)
+    gap = path("gap", "BUS", x=[1.0, np.nan, 3.0])  # an observation without a position is left out
+    shown = moment(path("ego", program="ego"), late, once, gap)
     summary = ox.write_openscenario([shown], tmp_path, CREATED)
     back = assert_matches_moment(summary.files[0], shown)
     walker = back["entities"]["obj_late"]
     assert walker["init"][0] == 7.0 and walker["vertices"][0][0] == pytest.approx(0.2)
     assert walker["size"] == (0.5, 0.5, 1.8)  # the pedestrian default where no size, the labeled height kept
     assert back["entities"]["obj_once"]["vertices"] == []
+    assert [v[:2] for v in back["entities"]["obj_gap"]["vertices"]] == [(0.0, 1.0), (pytest.approx(0.2), 3.0)]
     assert (summary.default_size, summary.without_trajectory, summary.without_road_network) == (1, 1, 1)
     description = back["header"]["description"]
     assert "default dimensions (no labeled size) for obj_late" in description
@@ -261,7 +263,7 @@ def test_the_road_file_is_relative_to_the_output_file_and_output_is_deterministi
 
 FINITE = st.floats(-1e5, 1e5, allow_nan=False)
 HEADINGS = st.one_of(
-    st.floats(-4 * math.pi, 4 * math.pi), st.sampled_from([math.pi, -math.pi, 0.0, 3.14159265, -3.1416])
+    st.floats(-4 * math.pi, 4 * math.pi), st.sampled_from([math.pi, -math.pi, 0.0, 3.14159265, -3.1416, math.nan])
 )
 SIZES = st.one_of(st.just(float("nan")), st.floats(0.1, 30.0))
 CATEGORIES = st.sampled_from(["REGULAR_VEHICLE", "vehicle.truck", "PEDESTRIAN", "DOG", "BOLLARD", "Van", "thing"])

@@ -210,7 +210,7 @@ def test_partly_observed_objects_start_at_their_first_observation_and_nan_sizes_
     assert [v[:2] for v in back["entities"]["obj_gap"]["vertices"]] == [(0.0, 1.0), (pytest.approx(0.2), 3.0)]
     assert (summary.default_size, summary.without_trajectory, summary.without_road_network) == (1, 1, 1)
     description = back["header"]["description"]
-    assert "default dimensions (no labeled size) for obj_late" in description
+    assert "category's default for a dimension not labeled: obj_late" in description
     assert "observed at one frame, no trajectory: obj_once" in description
     assert "no road network: the trace has no map" in description
     assert float(back["stop"].get("value")) == pytest.approx(0.5)  # the storyboard stops after the last observation

@@ -122,8 +122,8 @@ def _openscenario(args: argparse.Namespace) -> int:
             )
         if summary.default_size:
             print(
-                f"scenegrep: {summary.default_size} objects have no labeled size: written with their category's "
-                "default dimensions",
+                f"scenegrep: {summary.default_size} objects lack a labeled length, width or height: written with "
+                "their category's default for it (named in each file's FileHeader description)",
                 file=sys.stderr,
             )
         if summary.without_trajectory:

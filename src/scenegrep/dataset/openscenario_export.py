@@ -232,7 +232,7 @@ def scenario_element(moment: Moment, target: Path, created: dt.datetime) -> tupl
     road, road_note = _road_network(xosc, moment, target)
     notes = [road_note] if road_note else []
     if defaulted:
-        notes.append("default dimensions (no labeled size) for " + ", ".join(defaulted))
+        notes.append("category's default for a dimension not labeled: " + ", ".join(defaulted))
     if single:
         notes.append("observed at one frame, no trajectory: " + ", ".join(single))
     scenario = xosc.Scenario(

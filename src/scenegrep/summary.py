@@ -67,6 +67,7 @@ def map_summary(road_map: RoadMap) -> dict[str, Any]:
         "crosswalks": len(road_map.crosswalks),
         "sidewalks": len(road_map.sidewalks),
         "curbs": len(road_map.curbs),
+        "stop_lines": len(road_map.stop_lines),
         "unknown_layers": sorted(road_map.unknown_layers),
         "extent_m": [round(max_x - min_x, 1), round(max_y - min_y, 1)],
     }

@@ -48,11 +48,13 @@ def _trace_lines(t: dict[str, Any]) -> list[str]:
 
 
 def _map_lines(m: dict[str, Any]) -> list[str]:
+    stop_lines = f", {m['stop_lines']} stop lines" if m.get("stop_lines") else ""
     unknown = f"; unknown (not published): {', '.join(m['unknown_layers'])}" if m["unknown_layers"] else ""
     return [
         f"  map {m['name']}: {m['lanes']} lanes ({m['intersection_lanes']} in intersections), "
         f"{m['roads']} roads, {m['intersections']} intersections, {m['crosswalks']} crosswalks, "
-        f"{m['sidewalks']} sidewalks, {m['curbs']} curbs{unknown}; extent {m['extent_m'][0]} x {m['extent_m'][1]} m"
+        f"{m['sidewalks']} sidewalks, {m['curbs']} curbs{stop_lines}{unknown}; "
+        f"extent {m['extent_m'][0]} x {m['extent_m'][1]} m"
     ]
 
 

@@ -1,4 +1,5 @@
-"""Lane shapes from centrelines and widths, for maps that give lanes as centrelines."""
+"""Lane shapes: from centrelines and widths (maps that give lanes as centrelines), and from
+left and right bounds (maps that give lanes as bounds running in the direction of travel)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,22 @@ def resample_polyline(line: np.ndarray, n: int) -> np.ndarray:
     """``n`` points (n x 2) evenly spaced by arc length along a polyline (k x 2)."""
     geom = shapely.linestrings(line)
     return shapely.get_coordinates(shapely.line_interpolate_point(geom, np.linspace(0.0, 1.0, n), normalized=True))
+
+
+BOUND_CENTRELINE_POINTS = 20
+"""How many points a centreline derived from a lane's two bounds has."""
+
+
+def centreline_between(left: np.ndarray, right: np.ndarray, n: int = BOUND_CENTRELINE_POINTS) -> np.ndarray:
+    """The centreline (n x 2) of a lane between its ``left`` and ``right`` bounds (k x 2, both in
+    the direction of travel): the mean of the two bounds resampled to ``n`` points each."""
+    return (resample_polyline(left, n) + resample_polyline(right, n)) / 2.0
+
+
+def polygon_between(left: np.ndarray, right: np.ndarray) -> BaseGeometry:
+    """The polygon of a lane between its ``left`` and ``right`` bounds (k x 2, in the direction
+    of travel): the ring along the left bound and back along the right, made valid."""
+    return shapely.make_valid(shapely.Polygon(np.vstack([left[:, :2], right[::-1, :2]])))
 
 
 def _normals(centreline: np.ndarray) -> np.ndarray:

@@ -1,8 +1,8 @@
 """A road map as one Arrow table (scenegrep's Parquet map files and map cache).
 
 One row per map element; ``kind`` is lane, road, intersection, crosswalk,
-sidewalk, shoulder, curb or drivable. Geometries are WKB (polygons; a curb is a line
-string); lanes also carry their centreline and topology columns, sidewalks and crosswalks their
+sidewalk, shoulder, curb, stop_line or drivable. Geometries are WKB (polygons; a curb or stop
+line is a line string); lanes also carry their centreline and topology columns, sidewalks and crosswalks their
 centreline where the map has one (a file written before they were kept has none: their direction
 is unknown). The metadata names the
 layers the map's format does not publish (``unknown_layers``, layout 2); a layout-1 file, written
@@ -81,8 +81,9 @@ def map_to_table(road_map: RoadMap) -> pa.Table:
             for a in getattr(road_map, name)
         ]
     rows += [
-        {"kind": "curb", "id": str(i), "geometry": shapely.to_wkb(shapely.linestrings(c))}
-        for i, c in enumerate(road_map.curbs)
+        {"kind": kind, "id": str(i), "geometry": shapely.to_wkb(shapely.linestrings(line))}
+        for kind, lines in (("curb", road_map.curbs), ("stop_line", road_map.stop_lines))
+        for i, line in enumerate(lines)
     ]
     if road_map.drivable_area is not None:
         rows.append({"kind": "drivable", "id": "drivable", "geometry": shapely.to_wkb(road_map.drivable_area)})
@@ -114,7 +115,7 @@ def map_from_table(table: pa.Table) -> RoadMap:
         raise ValueError(f"unsupported map layout {meta.get('layout')!r}")
     rows = table.to_pylist()
     geometry = shapely.from_wkb(np.array([r["geometry"] for r in rows], dtype=object))
-    lanes, areas, curbs, drivable = [], {k: [] for k in _AREA_KINDS}, [], None
+    lanes, areas, lines, drivable = [], {k: [] for k in _AREA_KINDS}, {"curb": [], "stop_line": []}, None
     for row, geom in zip(rows, geometry):
         kind = row["kind"]
         if kind == "lane":
@@ -136,11 +137,12 @@ def map_from_table(table: pa.Table) -> RoadMap:
         elif kind in areas:
             centre = None if row["centreline"] is None else _coordinates(row["centreline"])
             areas[kind].append(Area(row["id"], geom, tuple(row["lanes"] or ()), centre))
-        elif kind == "curb":
-            curbs.append(shapely.get_coordinates(geom))
+        elif kind in lines:
+            lines[kind].append(shapely.get_coordinates(geom))
         elif kind == "drivable":
             drivable = geom
     road, intersection, crosswalk, sidewalk, shoulder = (tuple(areas[k]) for k in _AREA_KINDS)
+    curbs = lines["curb"]
     held = {"crossing": crosswalk, "sidewalk": sidewalk, "curb": curbs, "shoulder": shoulder}
     return RoadMap(
         meta["name"],
@@ -154,6 +156,7 @@ def map_from_table(table: pa.Table) -> RoadMap:
         meta.get("source"),
         shoulder,
         _unknown_layers(meta, held),
+        tuple(lines["stop_line"]),
     )
 
 

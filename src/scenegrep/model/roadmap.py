@@ -83,7 +83,10 @@ class RoadMap:
     ``unknown_layers`` (a subset of :data:`OPTIONAL_LAYERS`) are the layers the map's format does
     not publish: their elements are *unknown*, not absent. Every other layer holds exactly the
     elements given, so a published layer with no elements is *empty*. Readers state it per format;
-    a map built in code publishes every layer."""
+    a map built in code publishes every layer.
+
+    ``stop_lines`` are the stop lines (k x 2 polylines, metres) of a map that draws them (Lanelet2);
+    they are held and counted, and no query reads them yet."""
 
     name: str
     lanes: tuple[Lane, ...]
@@ -96,6 +99,7 @@ class RoadMap:
     source: str | None = field(default=None, compare=False)
     shoulders: tuple[Area, ...] = ()
     unknown_layers: frozenset[str] = frozenset()
+    stop_lines: tuple[np.ndarray, ...] = ()
 
     def __post_init__(self) -> None:
         odd = set(self.unknown_layers) - set(OPTIONAL_LAYERS)

@@ -69,6 +69,7 @@ FORMATS: dict[str, Format] = {
         Format("waymo-tfrecord", "waymo_tfrecord", "Waymo Open Motion Scenario TFRecord", True, True, many=True),
         Format("commonroad", "commonroad", "CommonRoad 2018b/2020a scenario XML", True, True),
         Format("opendrive", "opendrive", "OpenDRIVE road network (.xodr) through Scenic", False, True),
+        Format("lanelet2", "lanelet2", "Lanelet2 map (.osm, as Autoware uses it)", False, True),
         Format(
             "trace-folder", "trace_folder", "folder of trace files (each read in name order)", True, False, many=True
         ),
@@ -108,6 +109,8 @@ def sniff_file(path: Path) -> str | None:
     simple = {".pkl": "scenarionet", ".pickle": "scenarionet", ".xodr": "opendrive", ".xml": "commonroad"}
     if suffix in simple:
         return simple[suffix]
+    if suffix == ".osm":
+        return "lanelet2" if module("lanelet2").is_lanelet_map(path) else None
     if suffix == ".tfrecord" or ".tfrecord-" in path.name:
         return "waymo-tfrecord"
     return None

@@ -20,13 +20,12 @@ import shapely
 
 from ..errors import UserError, at
 from ..model import Area, Lane, LaneNeighbour, RoadMap
-from ..model.lane_shapes import resample_polyline
+from ..model.lane_shapes import centreline_between, polygon_between
 from ..model.lane_topology import derive_intersections, derive_roads
 from .common import field, read_bytes, reading
 
 FORMAT = "av2-map"
 _LANE_KINDS = {"VEHICLE": "vehicle", "BIKE": "bike", "BUS": "bus"}
-_RESAMPLE_POINTS = 20
 UNKNOWN_LAYERS = frozenset({"sidewalk", "curb", "shoulder"})
 """Layers the AV2 map format does not publish (its drivable area includes the shoulders)."""
 
@@ -52,12 +51,9 @@ def _lane(seg: dict[str, Any], path: Path, directions: dict[str, np.ndarray]) ->
     where = f"lane segment {lane_id}"
     left = _polyline(field(seg, "left_lane_boundary", path, where), path, where)
     right = _polyline(field(seg, "right_lane_boundary", path, where), path, where)
-    if "centerline" in seg:
-        centre = _polyline(seg["centerline"], path, where)
-    else:
-        centre = (resample_polyline(left, _RESAMPLE_POINTS) + resample_polyline(right, _RESAMPLE_POINTS)) / 2.0
+    centre = _polyline(seg["centerline"], path, where) if "centerline" in seg else centreline_between(left, right)
     directions[lane_id] = centre[-1] - centre[0]
-    polygon = shapely.make_valid(shapely.Polygon(np.vstack([left, right[::-1]])))
+    polygon = polygon_between(left, right)
     return Lane(
         lane_id,
         polygon,

@@ -31,7 +31,7 @@ def _turn(points: list[tuple[float, float]]) -> str:
     """Autoware's turn_direction of a bound: left or right where it turns more than 30 degrees."""
     xy = np.array(points)
     start, end = xy[1] - xy[0], xy[-1] - xy[-2]
-    angle = np.degrees(np.arctan2(np.cross(start, end), np.dot(start, end)))
+    angle = np.degrees(np.arctan2(start[0] * end[1] - start[1] * end[0], np.dot(start, end)))
     return "left" if angle > 30 else "right" if angle < -30 else "straight"
 
 

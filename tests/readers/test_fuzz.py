@@ -100,6 +100,7 @@ CASES = [
         "USA_US101-3_3_T-1.xml",
         {"USA_US101-3_3_T-1.xml": (*m.BYTE_MUTATIONS, *(m.xml_document,) * 3)},
     ),
+    Case("lanelet2", (), "map.osm", {"map.osm": (*m.BYTE_MUTATIONS, *(m.xml_document,) * 3)}, examples=3),
     Case(
         "trace-folder",
         (SAMPLE, REPO / "examples/sample/s3_pass_pedestrian-001.parquet"),
@@ -136,7 +137,18 @@ def _write_map_parquet(folder: Path) -> None:
     write_map_parquet(read_map(FORECAST / f"log_map_archive_{FORECAST.name}.json"), folder / "map.parquet")
 
 
-SEEDS = {"scenegrep-json": _write_json_trace, "scenegrep-map-parquet": _write_map_parquet}
+def _write_lanelet2(folder: Path) -> None:
+    """The seed of the lanelet2 case: the AV2 sensor log's map written as a Lanelet2 map."""
+    from tests.readers.lanelet2_writer import write_lanelet2
+
+    write_lanelet2(json.loads((SENSOR / SENSOR_MAP).read_bytes()), folder / "map.osm")
+
+
+SEEDS = {
+    "scenegrep-json": _write_json_trace,
+    "scenegrep-map-parquet": _write_map_parquet,
+    "lanelet2": _write_lanelet2,
+}
 """Cases whose seed file is written from a real input rather than copied."""
 
 

@@ -145,11 +145,13 @@ def test_lat_lon_nodes_are_projected_to_metres(tmp_path):
     assert length == pytest.approx(50, rel=1e-3) and lane.polygon.area / length == pytest.approx(3.5, rel=1e-3)
 
 
-def test_parquet_round_trip_keeps_stop_lines(hand_map, tmp_path):
+def test_stop_lines_travel_through_parquet_equality_and_cropping(hand_map, tmp_path):
     from scenegrep.readers.trace_parquet import read_map as read_map_parquet
 
     again = read_map_parquet(write_map_parquet(hand_map, tmp_path / "m.parquet"))
     assert again.equals(hand_map) and len(again.stop_lines) == 1
+    assert not dataclasses.replace(hand_map, stop_lines=()).equals(hand_map)
+    assert len(hand_map.crop(23, 0, 5).stop_lines) == 1 and hand_map.crop(0, 0, 5).stop_lines == ()
 
 
 MALFORMED = [

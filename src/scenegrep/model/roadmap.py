@@ -285,11 +285,12 @@ class RoadMap:
             (self.sidewalks, other.sidewalks),
             (self.shoulders, other.shoulders),
         ]
-        if any(len(a) != len(b) for a, b in pairs) or len(self.curbs) != len(other.curbs):
+        lines = [(self.curbs, other.curbs), (self.stop_lines, other.stop_lines)]
+        if any(len(a) != len(b) for a, b in pairs + lines):
             return False
         if not all(_same_element(x, y) for a, b in pairs for x, y in zip(a, b)):
             return False
-        if not all(np.array_equal(a, b) for a, b in zip(self.curbs, other.curbs)):
+        if not all(np.array_equal(x, y) for a, b in lines for x, y in zip(a, b)):
             return False
         if (self.drivable_area is None) != (other.drivable_area is None):
             return False
@@ -306,7 +307,10 @@ class RoadMap:
 
         lanes = tuple(self.lanes[i] for i in self._lane_tree.query(disc, predicate="intersects").tolist())
         lanes = tuple(sorted(lanes, key=lambda lane: self.lane_index[lane.id]))
-        curbs = tuple(c for c in self.curbs if shapely.linestrings(c).intersects(disc))
+        curbs, stop_lines = (
+            tuple(c for c in lines if shapely.linestrings(c).intersects(disc))
+            for lines in (self.curbs, self.stop_lines)
+        )
         drivable = None if self.drivable_area is None else self.drivable_area.intersection(disc)
         return RoadMap(
             self.name,
@@ -320,6 +324,7 @@ class RoadMap:
             self.source,
             near(self.shoulders),
             self.unknown_layers,
+            stop_lines,
         )
 
 

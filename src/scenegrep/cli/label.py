@@ -32,7 +32,9 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("data", nargs="+", metavar="DATA", help="labeled traces (files or recording directories)")
     parser.add_argument("-o", "--output", required=True, metavar="OUT", help="directory for the labelled traces")
-    parser.add_argument("--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr file)")
+    parser.add_argument(
+        "--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr or a Lanelet2 .osm file)"
+    )
     parser.add_argument("--config", metavar="FILE", help="thresholds file (layout of the shipped thresholds.toml)")
     parser.add_argument(
         "--min-confidence", type=float, metavar="C", help="keep behaviours with confidence >= C (default from config)"

@@ -47,7 +47,9 @@ def add_tolerance_arguments(parser: argparse.ArgumentParser) -> None:
     """``--map`` and the scene tolerances, shared by the Scenic query commands."""
     from ..scene.profiles import PROFILES
 
-    parser.add_argument("--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr file)")
+    parser.add_argument(
+        "--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr or a Lanelet2 .osm file)"
+    )
     parser.add_argument(
         "--tolerance-profile",
         metavar="NAME",

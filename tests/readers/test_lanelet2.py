@@ -130,6 +130,29 @@ def test_intersection_area_polygon_holds_the_lanes_naming_it(tmp_path):
     assert area.lanes == ("101",) and shapely.equals(area.polygon, shapely.box(10, 0, 20, 3))
 
 
+def test_crosswalk_regulatory_elements_give_exact_polygons(tmp_path):
+    """Autoware's crosswalk_polygon replaces the polygon of the crosswalk lanelet it refers to (the
+    lanelet still orients it); one referring to no crosswalk lanelet is a crossing of its own,
+    without direction."""
+    nodes = NODES | {60: (22, -2), 61: (24, -2), 62: (24, 5), 63: (22, 5), 64: (30, 0), 65: (31, 0), 66: (31, 1)}
+    ways = WAYS | {
+        42: ([60, 61, 62, 63], {"type": "crosswalk_polygon", "area": "yes"}),
+        43: ([64, 65, 66], {"type": "crosswalk_polygon", "area": "yes"}),
+    }
+    element = {"type": "regulatory_element", "subtype": "crosswalk"}
+    relations = RELATIONS | {
+        300: ([("way", 41, "ref_line"), ("way", 42, "crosswalk_polygon"), ("relation", 200, "refers")], element),
+        301: ([("way", 43, "crosswalk_polygon")], element),
+    }
+    path = tmp_path / "crosswalks.osm"
+    path.write_text(osm(nodes, ways, relations))
+    lanelet_crossing, own = lanelet2.read_map(path).crosswalks
+    assert (
+        shapely.equals(lanelet_crossing.polygon, shapely.box(22, -2, 24, 5)) and lanelet_crossing.centreline is not None
+    )
+    assert shapely.equals(own.polygon, shapely.Polygon([(30, 0), (31, 0), (31, 1)])) and own.centreline is None
+
+
 def test_lat_lon_nodes_are_projected_to_metres(tmp_path):
     """Without local_x/local_y, lat/lon go through UTM: a lane 3.5 m wide (in latitude) and 50 m
     long (in longitude) near Tokyo keeps its size within the UTM scale error (< 0.1 %)."""

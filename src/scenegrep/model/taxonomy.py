@@ -70,6 +70,12 @@ _EXACT = {
     "roadboundary": "static",
     "unknown": "other",
     "other": "other",
+    # Autoware ObjectClassification labels (others are above: CAR, TRUCK, BUS, ...)
+    "trailer": "trailer",
+    "animal": "animal",
+    "hazard": "static",
+    "over_drivable": "static",
+    "under_drivable": "static",
     "train": "other",
 }
 

@@ -71,6 +71,13 @@ FORMATS: dict[str, Format] = {
         Format("opendrive", "opendrive", "OpenDRIVE road network (.xodr) through Scenic", False, True),
         Format("lanelet2", "lanelet2", "Lanelet2 map (.osm, as Autoware uses it)", False, True),
         Format(
+            "ros-bag",
+            "ros.reader",
+            "MCAP file or ROS 2 bag directory (Autoware objects, /tf, odometry)",
+            True,
+            False,
+        ),
+        Format(
             "trace-folder", "trace_folder", "folder of trace files (each read in name order)", True, False, many=True
         ),
     )
@@ -113,6 +120,8 @@ def sniff_file(path: Path) -> str | None:
         return "lanelet2" if module("lanelet2").is_lanelet_map(path) else None
     if suffix == ".tfrecord" or ".tfrecord-" in path.name:
         return "waymo-tfrecord"
+    if suffix == ".mcap":
+        return "ros-bag"
     return None
 
 
@@ -126,6 +135,8 @@ def detect_format(path: str | Path) -> str:
             return "av2-sensor"
         if any(path.glob("scenario_*.parquet")):
             return "av2-forecasting"
+        if (path / "metadata.yaml").is_file() and any(path.glob("*.mcap")):
+            return "ros-bag"
         if module("trace-folder").trace_files(path):
             return "trace-folder"
         raise UserError("a directory that is neither an Argoverse 2 log or scenario nor holds trace files", at(path))

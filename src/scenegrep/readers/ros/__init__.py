@@ -1,0 +1,7 @@
+"""ROS 2 bags and MCAP files: raw messages -> decoded boxes and transforms -> frames.
+
+Modules, one concept each: :mod:`.messages` (the records), :mod:`.msgdef` (message definitions),
+:mod:`.cdr` (vectorised CDR decoding), :mod:`.decoders` (per message type), :mod:`.transforms`
+(the tf buffer), :mod:`.framing` (the incremental pipeline), :mod:`.bag` (files to messages),
+:mod:`.reader` (the ``ros-bag`` format).
+"""

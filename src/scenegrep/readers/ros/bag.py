@@ -1,0 +1,104 @@
+"""Bag files to raw messages: MCAP files (read as a stream, in file order) and ROS 2 bag
+directories (``metadata.yaml`` with ``.mcap`` storage files, read in their numbers' order).
+
+Records are bounded before they are read: a record or a chunk's stated uncompressed size over
+:data:`MAX_RECORD_BYTES` is refused; a file that ends early is a :class:`UserError` naming the
+last message read (topic and log time).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import BinaryIO
+
+from mcap.exceptions import McapError
+from mcap.records import Channel, Chunk, Message, Schema
+from mcap.stream_reader import StreamReader, breakup_chunk
+
+from ...errors import UserError, at
+from .messages import RawMessage
+
+MAX_RECORD_BYTES = 1 << 30
+"""The largest MCAP record or uncompressed chunk read."""
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+@dataclass(frozen=True)
+class _Topic:
+    topic: str
+    schema: Schema | None
+    encoding: str
+
+
+def is_bag_directory(path: Path) -> bool:
+    """Whether ``path`` is a ROS 2 bag directory (``metadata.yaml`` and storage files)."""
+    return (path / "metadata.yaml").is_file() and any(path.glob("*.mcap"))
+
+
+def storage_files(path: Path) -> list[Path]:
+    """The MCAP files of a bag: the file itself, or a bag directory's ``.mcap`` files in the
+    order rosbag2 numbers them (``name_0.mcap``, ``name_1.mcap``, ..., ``name_10.mcap``)."""
+    if not path.is_dir():
+        return [path]
+
+    def number(file: Path) -> tuple:
+        return tuple(int(p) if p.isdigit() else p for p in re.split(r"(\d+)", file.name))
+
+    return sorted(path.glob("*.mcap"), key=number)
+
+
+def _records(stream: BinaryIO) -> Iterator[object]:
+    reader = StreamReader(stream, emit_chunks=True, record_size_limit=MAX_RECORD_BYTES)
+    for record in reader.records:
+        if isinstance(record, Chunk):
+            if record.uncompressed_size > MAX_RECORD_BYTES:
+                raise McapError(f"a chunk of {record.uncompressed_size} bytes (at most {MAX_RECORD_BYTES})")
+            yield from breakup_chunk(record)
+        else:
+            yield record
+
+
+def messages(stream: BinaryIO, source: str) -> Iterator[RawMessage]:
+    """The messages of an MCAP stream in file order (schemas and channels as they are defined)."""
+    schemas: dict[int, Schema] = {}
+    channels: dict[int, _Topic] = {}
+    last: RawMessage | None = None
+    try:
+        for record in _records(stream):
+            if isinstance(record, Schema):
+                schemas[record.id] = record
+            elif isinstance(record, Channel):
+                channels[record.id] = _Topic(record.topic, schemas.get(record.schema_id), record.message_encoding)
+            elif isinstance(record, Message):
+                channel = channels.get(record.channel_id)
+                if channel is None:
+                    raise UserError(
+                        f"message at log time {record.log_time} ns on channel {record.channel_id}, never defined",
+                        at(source),
+                    )
+                schema = channel.schema
+                last = RawMessage(
+                    channel.topic,
+                    schema.name if schema else "",
+                    schema.encoding if schema else "",
+                    schema.data if schema else b"",
+                    channel.encoding,
+                    record.log_time,
+                    record.data,
+                )
+                yield last
+    except (McapError, EOFError, ValueError, KeyError, OSError) as exc:
+        after = "at its start" if last is None else f"after topic {last.topic}, message at log time {last.log_time} ns"
+        detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise UserError(f"not a valid MCAP file (truncated or corrupt?) {after}: {detail}", at(source)) from None
+
+
+def bag_messages(path: str | Path) -> Iterator[RawMessage]:
+    """Every message of an MCAP file or a ROS 2 bag directory, file after file."""
+    for file in storage_files(Path(path)):
+        with open(file, "rb") as handle:
+            yield from messages(handle, str(file))

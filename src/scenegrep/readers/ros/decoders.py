@@ -1,0 +1,235 @@
+"""Schema-specialised decoders: a batch of CDR messages of one type into :class:`Boxes` or
+:class:`Transforms`.
+
+Each decoder names the fields it needs; :func:`scenegrep.readers.ros.cdr.decode` reads just
+those, for the whole batch at once, from the message definition the bag carries (so any
+field order or added field of a message version is read right). Supported types (by
+``pkg/Type``; ``pkg/msg/Type`` is the same):
+
+- ``autoware_perception_msgs/TrackedObjects``, ``autoware_auto_perception_msgs/TrackedObjects``:
+  UUID, most probable classification, pose, twist (the object's own frame), shape;
+- ``autoware_perception_msgs/DetectedObjects`` (and the ``autoware_auto`` name): as above,
+  without ids (each detection gets its own id ``<stamp ns>:<rank>``) and with the twist only
+  where ``has_twist`` is set;
+- ``tf2_msgs/TFMessage`` (``/tf``, ``/tf_static``) and ``nav_msgs/Odometry`` (a link from its
+  ``header.frame_id`` to its ``child_frame_id``).
+
+Shapes: a bounding box gives length, width, height (its dimensions x, y, z); a cylinder its
+diameter as length and width; a polygon only its height (length and width unknown, NaN).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from functools import lru_cache
+
+import numpy as np
+
+from .cdr import Level, Payloads, decode
+from .messages import Boxes, Transforms
+from .msgdef import Field, normalise, parse_schema
+
+AUTOWARE_LABELS = (
+    "UNKNOWN",
+    "CAR",
+    "TRUCK",
+    "BUS",
+    "TRAILER",
+    "MOTORCYCLE",
+    "BICYCLE",
+    "PEDESTRIAN",
+    "ANIMAL",
+    "HAZARD",
+    "OVER_DRIVABLE",
+    "UNDER_DRIVABLE",
+)
+"""Autoware's ``ObjectClassification`` labels by value; a value past them reads as UNKNOWN."""
+
+_POSE = "kinematics.pose_with_covariance.pose."
+_TWIST = "kinematics.twist_with_covariance.twist.linear."
+_XYZ = ("x", "y", "z")
+
+
+@lru_cache(maxsize=64)
+def types_of(schema_name: str, schema_data: bytes) -> dict[str, tuple[Field, ...]]:
+    """The parsed definitions of a schema (cached: a bag has a few schemas, read many times)."""
+    return parse_schema(schema_name, schema_data.decode("utf-8", "replace"))
+
+
+def _stamp(fields: dict[str, np.ndarray], prefix: str = "header.stamp.") -> np.ndarray:
+    return fields[prefix + "sec"].astype(np.int64) * 1_000_000_000 + fields[prefix + "nanosec"].astype(np.int64)
+
+
+def _frames(names: np.ndarray) -> np.ndarray:
+    out = np.empty(len(names), dtype=object)
+    out[:] = [str(n).lstrip("/") for n in names]
+    return out
+
+
+def _ordered(level: Level) -> np.ndarray:
+    """The rows of a level in message order (by parent, then position in the sequence)."""
+    return np.lexsort((level.rank, level.parent))
+
+
+def _vector(fields: dict[str, np.ndarray], prefix: str, names: Sequence[str], rows: np.ndarray) -> np.ndarray:
+    return np.stack([fields[prefix + n].astype(np.float64)[rows] for n in names], axis=1)
+
+
+def _best_class(levels: dict[str, Level], n_objects: int) -> np.ndarray:
+    """The most probable label of every object (decode order; UNKNOWN without a classification;
+    the first of equally probable ones)."""
+    best = np.zeros(n_objects, dtype=np.int64)
+    classes = levels.get("objects.classification")
+    if classes is not None and len(classes.parent):
+        order = np.lexsort((classes.rank, -classes.fields["probability"].astype(np.float64), classes.parent))
+        parent = classes.parent[order]
+        first = np.r_[True, parent[1:] != parent[:-1]]
+        best[parent[first]] = classes.fields["label"][order][first]
+    return np.where(best < len(AUTOWARE_LABELS), best, 0)
+
+
+def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:
+    size = _vector(fields, "shape.dimensions.", _XYZ, rows)
+    kind = fields["shape.type"][rows]
+    size[kind == 1, 1] = size[kind == 1, 0]
+    size[kind == 2, :2] = np.nan
+    size[kind > 2] = np.nan
+    return size
+
+
+def _uuid_text(raw: np.ndarray) -> np.ndarray:
+    """Canonical UUID strings of (n, 16) bytes (formatted once per distinct UUID)."""
+    unique, inverse = np.unique(np.ascontiguousarray(raw).view("V16").ravel(), return_inverse=True)
+    texts = []
+    for value in unique:
+        h = bytes(value).hex()
+        texts.append(f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:]}")
+    out = np.empty(len(unique), dtype=object)
+    out[:] = texts
+    return out[inverse.ravel()]
+
+
+def _autoware(tracked: bool) -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:
+    wanted = {"header.stamp.sec", "header.stamp.nanosec", "header.frame_id", "objects.shape.type"}
+    wanted |= {f"objects.{_POSE}position.{a}" for a in _XYZ}
+    wanted |= {f"objects.{_POSE}orientation.{a}" for a in "xyzw"}
+    wanted |= {f"objects.{_TWIST}{a}" for a in _XYZ}
+    wanted |= {f"objects.shape.dimensions.{a}" for a in _XYZ}
+    wanted |= {"objects.classification.label", "objects.classification.probability"}
+    wanted |= {"objects.object_id.uuid"} if tracked else {"objects.kinematics.has_twist"}
+
+    def boxes(levels: dict[str, Level]) -> Boxes:
+        top, objects = levels[""], levels.get("objects")
+        stamps, frames = _stamp(top.fields), _frames(top.fields["header.frame_id"])
+        if objects is None or not len(objects.parent):
+            return _no_boxes(stamps)
+        rows = _ordered(objects)
+        f = objects.fields
+        message = objects.parent[rows]
+        label = _best_class(levels, len(objects.parent))[rows]
+        velocity = _vector(f, _TWIST, _XYZ, rows)
+        if tracked:
+            ids = _uuid_text(f["object_id.uuid"][rows])
+        else:
+            velocity[f["kinematics.has_twist"][rows] == 0] = np.nan
+            ids = np.array([f"{s}:{r}" for s, r in zip(stamps[message], objects.rank[rows])], dtype=object)
+        return Boxes(
+            message,
+            stamps[message],
+            frames[message],
+            ids,
+            np.array(AUTOWARE_LABELS, dtype=object)[label],
+            _vector(f, _POSE + "position.", _XYZ, rows),
+            _vector(f, _POSE + "orientation.", "xyzw", rows),
+            _shape_size(f, rows),
+            velocity,
+            stamps,
+        )
+
+    return frozenset(wanted), boxes
+
+
+def _no_boxes(stamps: np.ndarray) -> Boxes:
+    empty, text, vectors = np.empty(0, np.int64), np.empty(0, dtype=object), np.empty((0, 3))
+    return Boxes(empty, empty, text, text, text, vectors, np.empty((0, 4)), vectors, vectors, stamps)
+
+
+def _tf() -> tuple[frozenset[str], Callable[[dict[str, Level]], Transforms]]:
+    prefix = "transforms."
+    wanted = {prefix + n for n in ("header.stamp.sec", "header.stamp.nanosec", "header.frame_id", "child_frame_id")}
+    wanted |= {f"{prefix}transform.translation.{a}" for a in _XYZ} | {f"{prefix}transform.rotation.{a}" for a in "xyzw"}
+
+    def links(levels: dict[str, Level]) -> Transforms:
+        level = levels.get("transforms")
+        if level is None or not len(level.parent):
+            return _no_links()
+        rows = _ordered(level)
+        f = level.fields
+        return Transforms(
+            level.parent[rows],
+            _stamp(f)[rows],
+            _frames(f["header.frame_id"][rows]),
+            _frames(f["child_frame_id"][rows]),
+            _vector(f, "transform.translation.", _XYZ, rows),
+            _vector(f, "transform.rotation.", "xyzw", rows),
+        )
+
+    return frozenset(wanted), links
+
+
+def _odometry() -> tuple[frozenset[str], Callable[[dict[str, Level]], Transforms]]:
+    wanted = {"header.stamp.sec", "header.stamp.nanosec", "header.frame_id", "child_frame_id"}
+    wanted |= {f"pose.pose.position.{a}" for a in _XYZ} | {f"pose.pose.orientation.{a}" for a in "xyzw"}
+
+    def links(levels: dict[str, Level]) -> Transforms:
+        f = levels[""].fields
+        rows = np.arange(len(levels[""].parent))
+        return Transforms(
+            rows,
+            _stamp(f),
+            _frames(f["header.frame_id"]),
+            _frames(f["child_frame_id"]),
+            _vector(f, "pose.pose.position.", _XYZ, rows),
+            _vector(f, "pose.pose.orientation.", "xyzw", rows),
+        )
+
+    return frozenset(wanted), links
+
+
+def _no_links() -> Transforms:
+    empty, text = np.empty(0, np.int64), np.empty(0, dtype=object)
+    return Transforms(empty, empty, text, text, np.empty((0, 3)), np.empty((0, 4)))
+
+
+_DECODERS: dict[str, Callable[[], tuple[frozenset[str], Callable[[dict[str, Level]], Boxes | Transforms]]]] = {
+    "autoware_perception_msgs/TrackedObjects": lambda: _autoware(True),
+    "autoware_auto_perception_msgs/TrackedObjects": lambda: _autoware(True),
+    "autoware_perception_msgs/DetectedObjects": lambda: _autoware(False),
+    "autoware_auto_perception_msgs/DetectedObjects": lambda: _autoware(False),
+    "tf2_msgs/TFMessage": _tf,
+    "nav_msgs/Odometry": _odometry,
+}
+
+BOX_TYPES = frozenset(name for name in _DECODERS if not name.startswith(("tf2_msgs", "nav_msgs")))
+"""The message types that give boxes."""
+
+LINK_TYPES = frozenset({"tf2_msgs/TFMessage", "nav_msgs/Odometry"})
+"""The message types that give frame links."""
+
+
+def type_key(schema_name: str) -> str:
+    """``pkg/Type`` of a schema name (``pkg/msg/Type`` accepted)."""
+    return normalise(schema_name, "")
+
+
+def supported(schema_name: str, message_encoding: str) -> bool:
+    """Whether messages of this schema and encoding are decoded."""
+    return message_encoding == "cdr" and type_key(schema_name) in _DECODERS
+
+
+def decode_cdr(schema_name: str, schema_data: bytes, payloads: Sequence[bytes]) -> Boxes | Transforms:
+    """The boxes or links of a batch of CDR messages of one supported schema (CdrError names the
+    first bad message; DefinitionError a schema that cannot be read or lacks a field)."""
+    wanted, build = _DECODERS[type_key(schema_name)]()
+    levels = decode(types_of(schema_name, schema_data), type_key(schema_name), Payloads.of(payloads), wanted)
+    return build(levels)

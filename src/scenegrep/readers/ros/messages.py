@@ -1,0 +1,74 @@
+"""The records of the bag pipeline: raw messages in, decoded boxes and transforms out.
+
+A :class:`RawMessage` is one message as a bag or MCAP stream holds it. Decoders turn a batch of
+raw messages of one type into :class:`Boxes` (3-D objects, poses in their message's frame) or
+:class:`Transforms` (time-stamped frame links, from ``/tf`` or an odometry topic). Times are
+integer nanoseconds; lengths metres; quaternions (x, y, z, w).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+
+class RawMessage(NamedTuple):
+    """One message: its topic, schema (name, encoding, definition bytes), message encoding,
+    log time (ns) and serialised bytes."""
+
+    topic: str
+    schema_name: str
+    schema_encoding: str
+    schema_data: bytes
+    message_encoding: str
+    log_time: int
+    data: bytes
+
+
+@dataclass(frozen=True)
+class Boxes:
+    """3-D boxes, one row per object observation: ``message`` (position of its message in the
+    decoded batch), ``stamp`` (its header stamp, ns), ``frame_id`` (frame of its pose), ``id``
+    (track id; '' when the message gives none), ``category`` (class name), position ``xyz``
+    (n, 3), orientation ``quat`` (n, 4), box ``size`` (length, width, height; NaN unknown)
+    and ``velocity`` (n, 3) in the box's own frame (x forward; NaN when not given);
+    ``message_stamps``: the header stamp of every message of the batch, with objects or not."""
+
+    message: np.ndarray
+    stamp: np.ndarray
+    frame_id: np.ndarray
+    id: np.ndarray
+    category: np.ndarray
+    xyz: np.ndarray
+    quat: np.ndarray
+    size: np.ndarray
+    velocity: np.ndarray
+    message_stamps: np.ndarray
+
+    ROWS = ("message", "stamp", "frame_id", "id", "category", "xyz", "quat", "size", "velocity")
+
+    def __len__(self) -> int:
+        return len(self.message)
+
+    def take(self, rows: np.ndarray) -> Boxes:
+        """The rows selected by an index or boolean array (``message_stamps`` kept whole)."""
+        return Boxes(*(getattr(self, f)[rows] for f in self.ROWS), self.message_stamps)
+
+
+@dataclass(frozen=True)
+class Transforms:
+    """Frame links: ``parent`` <- ``child`` at ``stamp`` (ns): the child's origin ``xyz`` (n, 3)
+    and orientation ``quat`` (n, 4) in the parent frame; ``static`` links hold at all times."""
+
+    message: np.ndarray
+    stamp: np.ndarray
+    parent: np.ndarray
+    child: np.ndarray
+    xyz: np.ndarray
+    quat: np.ndarray
+    static: bool = False
+
+    def __len__(self) -> int:
+        return len(self.message)

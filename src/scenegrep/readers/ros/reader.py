@@ -1,0 +1,47 @@
+"""The ``ros-bag`` format: MCAP files and ROS 2 bag directories read into one label trace.
+
+:func:`iter_chunks` runs the incremental pipeline (:mod:`.framing`) over a bag's messages in
+batches and yields each chunk of completed frames; :func:`read_trace` is that run to the end,
+its chunks concatenated. Options (topics, frame topic or rate, map and ego frames) are a
+:class:`BagOptions`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from itertools import islice
+from pathlib import Path
+
+from ...errors import UserError, at
+from ...model import LabelTrace, TraceSource, concatenate
+from .bag import bag_messages
+from .framing import BagOptions, frames
+from .messages import RawMessage
+
+FORMAT = "ros-bag"
+
+BATCH = 4096
+"""Messages decoded together by the offline reader."""
+
+
+def batches(messages: Iterable[RawMessage], size: int = BATCH) -> Iterator[list[RawMessage]]:
+    """``messages`` in lists of ``size`` (the last may be shorter)."""
+    iterator = iter(messages)
+    while batch := list(islice(iterator, size)):
+        yield batch
+
+
+def iter_chunks(
+    path: str | Path, options: BagOptions | None = None, note: Callable[[str], None] | None = None
+) -> Iterator[LabelTrace]:
+    """The chunks of frames of a bag, as the pipeline completes them."""
+    source = TraceSource(str(path), FORMAT)
+    yield from frames(batches(bag_messages(path)), options or BagOptions(), Path(path).stem, source, note)
+
+
+def read_trace(path: str | Path, options: BagOptions | None = None) -> LabelTrace:
+    """The whole bag as one trace (UserError when no frame could be built)."""
+    chunks = list(iter_chunks(path, options))
+    if not chunks:
+        raise UserError("no frames: the bag holds no messages of a supported box type (see scenegrep info)", at(path))
+    return concatenate(chunks)

@@ -1,0 +1,183 @@
+"""A transform buffer (ROS tf): frame links over time, looked up along a chain at any stamp.
+
+Each child frame has one parent (the latest link received names it; a link naming another
+parent replaces the child's history). A link's samples are kept sorted by stamp; at a stamp
+between two samples the translation is interpolated linearly and the rotation by slerp; at a
+sample's stamp it is that sample exactly. There is no extrapolation: a stamp before a link's
+first sample or after its last is missing (:class:`MissingTransform`). Static links
+(``/tf_static``) hold at every stamp. Quaternions are (x, y, z, w).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .messages import Transforms
+
+MAX_CHAIN = 64
+"""The most links a chain may have (a longer one is a cycle or a hostile tree)."""
+
+
+class MissingTransform(LookupError):
+    """No transform at some stamp: ``row`` is the first stamp (position) without one."""
+
+    def __init__(self, row: int, reason: str):
+        super().__init__(reason)
+        self.row = row
+        self.reason = reason
+
+
+def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton products a * b of (n, 4) quaternions (x, y, z, w)."""
+    ax, ay, az, aw = a.T
+    bx, by, bz, bw = b.T
+    return np.stack(
+        [
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz,
+        ],
+        axis=1,
+    )
+
+
+def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """(n, 3) vectors ``v`` rotated by unit quaternions ``q`` (n, 4)."""
+    u, w = q[:, :3], q[:, 3:4]
+    t = 2.0 * np.cross(u, v)
+    return v + w * t + np.cross(u, t)
+
+
+def normalised(q: np.ndarray) -> np.ndarray:
+    """Unit quaternions (a zero quaternion, as some writers leave unset, is the identity)."""
+    norm = np.linalg.norm(q, axis=1, keepdims=True)
+    return np.where(norm > 0, q / np.where(norm > 0, norm, 1.0), np.array([0.0, 0.0, 0.0, 1.0]))
+
+
+def slerp(q0: np.ndarray, q1: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Spherical linear interpolation between unit quaternions at fractions ``t`` (n,)."""
+    dot = np.sum(q0 * q1, axis=1)
+    q1 = np.where(dot[:, None] < 0, -q1, q1)
+    dot = np.abs(dot)
+    close = dot > 0.9995
+    theta = np.arccos(np.clip(dot, -1.0, 1.0))
+    sin = np.where(close, 1.0, np.sin(theta))
+    w0 = np.where(close, 1.0 - t, np.sin((1.0 - t) * theta) / sin)
+    w1 = np.where(close, t, np.sin(t * theta) / sin)
+    return normalised(w0[:, None] * q0 + w1[:, None] * q1)
+
+
+def yaw_of(q: np.ndarray) -> np.ndarray:
+    """Rotation about +z of quaternions (radians, counter-clockwise from +x)."""
+    x, y, z, w = q.T
+    return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+@dataclass
+class _Link:
+    parent: str
+    static: bool
+    stamps: list[int] = field(default_factory=list)
+    xyz: list[np.ndarray] = field(default_factory=list)
+    quat: list[np.ndarray] = field(default_factory=list)
+    _arrays: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+
+    def add(self, stamps: np.ndarray, xyz: np.ndarray, quat: np.ndarray) -> None:
+        self.stamps.extend(stamps.tolist())
+        self.xyz.append(xyz)
+        self.quat.append(normalised(quat))
+        self._arrays = None
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Stamps (sorted, one sample per stamp: the last received), positions, rotations."""
+        if self._arrays is None:
+            stamps = np.asarray(self.stamps, dtype=np.int64)
+            xyz, quat = np.concatenate(self.xyz), np.concatenate(self.quat)
+            order = np.argsort(stamps, kind="stable")
+            stamps, xyz, quat = stamps[order], xyz[order], quat[order]
+            last = np.r_[stamps[1:] != stamps[:-1], True]
+            self._arrays = (stamps[last], xyz[last], quat[last])
+            self.stamps, self.xyz, self.quat = self._arrays[0].tolist(), [self._arrays[1]], [self._arrays[2]]
+        return self._arrays
+
+    def at(self, stamps: np.ndarray, child: str) -> tuple[np.ndarray, np.ndarray]:
+        known, xyz, quat = self.arrays()
+        if self.static:
+            return np.repeat(xyz[-1:], len(stamps), axis=0), np.repeat(quat[-1:], len(stamps), axis=0)
+        outside = (stamps < known[0]) | (stamps > known[-1])
+        if outside.any():
+            row = int(np.argmax(outside))
+            raise MissingTransform(
+                row,
+                f"no transform {self.parent} <- {child} at {int(stamps[row])} ns "
+                f"(known from {int(known[0])} to {int(known[-1])} ns)",
+            )
+        upper = np.clip(np.searchsorted(known, stamps, side="left"), 1, max(len(known) - 1, 1))
+        lower = upper - 1
+        if len(known) == 1:
+            return xyz[lower], quat[lower]
+        span = (known[upper] - known[lower]).astype(np.float64)
+        t = np.clip((stamps - known[lower]) / span, 0.0, 1.0)
+        exact = stamps == known[upper]
+        t = np.where(exact, 1.0, t)
+        position = np.where(exact[:, None], xyz[upper], xyz[lower] + t[:, None] * (xyz[upper] - xyz[lower]))
+        return position, np.where(exact[:, None], quat[upper], slerp(quat[lower], quat[upper], t))
+
+
+class TfBuffer:
+    """Frame links received so far; :meth:`lookup` composes them along a chain at given stamps."""
+
+    def __init__(self) -> None:
+        self.links: dict[str, _Link] = {}
+
+    def add(self, links: Transforms, static: bool = False) -> None:
+        """Add the samples of ``links`` (``static``: they hold at every stamp)."""
+        if not len(links):
+            return
+        for child in dict.fromkeys(links.child.tolist()):
+            rows = np.flatnonzero(links.child == child)
+            parent = str(links.parent[rows[-1]])
+            rows = rows[links.parent[rows] == parent]
+            link = self.links.get(child)
+            if link is None or link.parent != parent or link.static != static:
+                link = self.links[child] = _Link(parent, static)
+            link.add(links.stamp[rows], links.xyz[rows], links.quat[rows])
+
+    def chain(self, frame: str, target: str) -> list[str] | None:
+        """The child frames whose links lead from ``frame`` up to ``target`` (empty when they are
+        the same frame), or None when ``frame`` does not reach ``target``."""
+        path: list[str] = []
+        while frame != target:
+            link = self.links.get(frame)
+            if link is None or len(path) >= MAX_CHAIN:
+                return None
+            path.append(frame)
+            frame = link.parent
+        return path
+
+    def latest(self, frame: str, target: str) -> int | None:
+        """The last stamp (ns) up to which ``frame``'s chain to ``target`` is known (None: no chain;
+        a chain of static links only is known at every stamp: the maximum int64)."""
+        path = self.chain(frame, target)
+        if path is None:
+            return None
+        ends = [self.links[c].arrays()[0][-1] for c in path if not self.links[c].static]
+        return int(min(ends)) if ends else np.iinfo(np.int64).max
+
+    def lookup(self, frame: str, target: str, stamps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Position (n, 3) and rotation (n, 4) of ``frame`` in ``target`` at each stamp (ns);
+        MissingTransform when there is no chain or a link is unknown at a stamp."""
+        stamps = np.asarray(stamps, dtype=np.int64)
+        path = self.chain(frame, target)
+        if path is None:
+            raise MissingTransform(0, f"no transform chain from frame {frame!r} to {target!r}")
+        xyz = np.zeros((len(stamps), 3))
+        quat = np.tile([0.0, 0.0, 0.0, 1.0], (len(stamps), 1))
+        for child in path:
+            link_xyz, link_quat = self.links[child].at(stamps, child)
+            xyz = quat_rotate(link_quat, xyz) + link_xyz
+            quat = quat_multiply(link_quat, quat)
+        return xyz, quat

@@ -1,0 +1,258 @@
+"""Test writers: label traces written as MCAP bags of ROS 2 messages (CDR through
+mcap-ros2-support's own encoder, an implementation independent of the reader's decoder).
+
+Message definitions are the upstream ``.msg`` files' fields (autoware_msgs 1.12,
+ros2/common_interfaces, geometry2's tf2_msgs), comments dropped; :func:`schema` joins a type's
+definition with every definition it uses, as rosbag2 writes ``ros2msg`` schemas.
+"""
+
+from __future__ import annotations
+
+import uuid
+from pathlib import Path
+
+import numpy as np
+from mcap_ros2.writer import Writer
+
+from scenegrep.model import LabelTrace
+from scenegrep.model.geometry import yaw_from_heading
+
+MSG = {
+    "builtin_interfaces/Time": "int32 sec\nuint32 nanosec",
+    "std_msgs/Header": "builtin_interfaces/Time stamp\nstring frame_id",
+    "geometry_msgs/Point": "float64 x\nfloat64 y\nfloat64 z",
+    "geometry_msgs/Point32": "float32 x\nfloat32 y\nfloat32 z",
+    "geometry_msgs/Vector3": "float64 x\nfloat64 y\nfloat64 z",
+    "geometry_msgs/Quaternion": "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1",
+    "geometry_msgs/Pose": "Point position\nQuaternion orientation",
+    "geometry_msgs/PoseWithCovariance": "Pose pose\nfloat64[36] covariance",
+    "geometry_msgs/Twist": "Vector3  linear\nVector3  angular",
+    "geometry_msgs/TwistWithCovariance": "Twist twist\nfloat64[36] covariance",
+    "geometry_msgs/Accel": "Vector3  linear\nVector3  angular",
+    "geometry_msgs/AccelWithCovariance": "Accel accel\nfloat64[36] covariance",
+    "geometry_msgs/Polygon": "Point32[] points",
+    "geometry_msgs/Transform": "Vector3 translation\nQuaternion rotation",
+    "geometry_msgs/TransformStamped": "std_msgs/Header header\nstring child_frame_id\nTransform transform",
+    "tf2_msgs/TFMessage": "geometry_msgs/TransformStamped[] transforms",
+    "nav_msgs/Odometry": (
+        "std_msgs/Header header\nstring child_frame_id\n"
+        "geometry_msgs/PoseWithCovariance pose\ngeometry_msgs/TwistWithCovariance twist"
+    ),
+    "unique_identifier_msgs/UUID": "uint8[16] uuid",
+    "autoware_perception_msgs/ObjectClassification": (
+        "uint8 UNKNOWN = 0\nuint8 CAR = 1\nuint8 TRUCK = 2\nuint8 BUS = 3\nuint8 TRAILER = 4\n"
+        "uint8 MOTORCYCLE = 5\nuint8 BICYCLE = 6\nuint8 PEDESTRIAN = 7\nuint8 ANIMAL = 8\nuint8 HAZARD = 9\n"
+        "uint8 OVER_DRIVABLE = 10\nuint8 UNDER_DRIVABLE = 11\nuint8 label\nfloat32 probability"
+    ),
+    "autoware_perception_msgs/Shape": (
+        "uint8 BOUNDING_BOX=0\nuint8 CYLINDER=1\nuint8 POLYGON=2\nuint8 type\n"
+        "geometry_msgs/Polygon footprint\ngeometry_msgs/Vector3 dimensions"
+    ),
+    "autoware_perception_msgs/TrackedObjectKinematics": (
+        "uint8 UNAVAILABLE=0\nuint8 SIGN_UNKNOWN=1\nuint8 AVAILABLE=2\n"
+        "geometry_msgs/PoseWithCovariance pose_with_covariance\n"
+        "geometry_msgs/TwistWithCovariance twist_with_covariance\n"
+        "geometry_msgs/AccelWithCovariance acceleration_with_covariance\n"
+        "uint8 orientation_availability\nbool is_stationary"
+    ),
+    "autoware_perception_msgs/TrackedObject": (
+        "unique_identifier_msgs/UUID object_id\nfloat32 existence_probability\n"
+        "ObjectClassification[] classification\nTrackedObjectKinematics kinematics\nShape shape"
+    ),
+    "autoware_perception_msgs/TrackedObjects": "std_msgs/Header header\nTrackedObject[] objects",
+    "autoware_perception_msgs/DetectedObjectKinematics": (
+        "uint8 UNAVAILABLE=0\nuint8 SIGN_UNKNOWN=1\nuint8 AVAILABLE=2\n"
+        "geometry_msgs/PoseWithCovariance pose_with_covariance\nbool has_position_covariance\n"
+        "uint8 orientation_availability\ngeometry_msgs/TwistWithCovariance twist_with_covariance\n"
+        "bool has_twist\nbool has_twist_covariance"
+    ),
+    "autoware_perception_msgs/DetectedObject": (
+        "float32 existence_probability\nObjectClassification[] classification\n"
+        "DetectedObjectKinematics kinematics\nShape shape"
+    ),
+    "autoware_perception_msgs/DetectedObjects": "std_msgs/Header header\nDetectedObject[] objects",
+}
+
+KIND_LABEL = {
+    "car": 1,
+    "truck": 2,
+    "bus": 3,
+    "trailer": 4,
+    "motorcycle": 5,
+    "bicycle": 6,
+    "pedestrian": 7,
+    "animal": 8,
+    "static": 9,
+    "other": 0,
+}
+"""The Autoware label a test writes for each scenegrep kind."""
+
+TRACKED_TOPIC = "/perception/object_recognition/tracking/objects"
+
+
+def _uses(name: str) -> list[str]:
+    package = name.split("/")[0]
+    found = []
+    for line in MSG[name].splitlines():
+        words = line.split()
+        if len(words) < 2 or "=" in words[1] or (len(words) > 2 and words[2].startswith("=")):
+            continue
+        base = words[0].split("[")[0]
+        if base[0].isupper() or "/" in base:
+            found.append(base if "/" in base else f"{package}/{base}")
+    return found
+
+
+def schema(name: str) -> str:
+    """The ``ros2msg`` schema text of a type: its definition, then every type it uses."""
+    order: list[str] = []
+    todo = _uses(name)
+    while todo:
+        used = todo.pop(0)
+        if used not in order:
+            order.append(used)
+            todo.extend(_uses(used))
+    parts = [MSG[name]] + [f"{'=' * 80}\nMSG: {u.replace('/', '/msg/')}\n{MSG[u]}" for u in order]
+    return "\n".join(parts)
+
+
+def object_uuid(object_id: str) -> bytes:
+    """The 16 bytes a test writes for an object id: the UUID itself when the id is one."""
+    try:
+        return uuid.UUID(object_id).bytes
+    except ValueError:
+        return uuid.uuid5(uuid.NAMESPACE_URL, object_id).bytes
+
+
+def read_back_id(object_id: str) -> str:
+    """The id the reader gives back for an object written with :func:`object_uuid`."""
+    return str(uuid.UUID(bytes=object_uuid(object_id)))
+
+
+def _stamp(ns: int) -> dict:
+    return {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
+
+
+def _quat(yaw: float) -> dict:
+    return {"x": 0.0, "y": 0.0, "z": float(np.sin(yaw / 2)), "w": float(np.cos(yaw / 2))}
+
+
+def frame_stamps(trace: LabelTrace, origin_ns: int) -> np.ndarray:
+    """The header stamp (ns) a test writes for every frame."""
+    return origin_ns + np.round(trace.frame_time * 1e9).astype(np.int64)
+
+
+class BagWriter:
+    """An MCAP file of ROS 2 messages: register types once, write dict messages."""
+
+    def __init__(self, path: Path):
+        self.writer = Writer(str(path))  # the writer opens the file and closes it on finish
+        self.schemas: dict[str, object] = {}
+
+    def write(self, topic: str, type_name: str, message: dict, log_time: int) -> None:
+        if type_name not in self.schemas:
+            self.schemas[type_name] = self.writer.register_msgdef(type_name.replace("/", "/msg/"), schema(type_name))
+        self.writer.write_message(topic, self.schemas[type_name], message, log_time=log_time, publish_time=log_time)
+
+    def close(self) -> None:
+        self.writer.finish()
+
+
+def tracked_object(object_id: str, kind: str, pose: dict, yaw: float, row: dict) -> dict:
+    """A TrackedObject message (dict) for one state row of a trace (pose in the ego frame)."""
+    velocity_body = row["velocity_body"]
+    cov = [0.0] * 36
+    return {
+        "object_id": {"uuid": list(object_uuid(object_id))},
+        "existence_probability": 1.0,
+        "classification": [
+            {"label": 0 if KIND_LABEL[kind] else 1, "probability": 0.25},
+            {"label": KIND_LABEL[kind], "probability": 0.75},
+        ],
+        "kinematics": {
+            "pose_with_covariance": {"pose": {"position": pose, "orientation": _quat(yaw)}, "covariance": cov},
+            "twist_with_covariance": {
+                "twist": {"linear": velocity_body, "angular": {"x": 0.0, "y": 0.0, "z": 0.0}},
+                "covariance": cov,
+            },
+            "acceleration_with_covariance": {
+                "accel": {"linear": {"x": 0.0, "y": 0.0, "z": 0.0}, "angular": {"x": 0.0, "y": 0.0, "z": 0.0}},
+                "covariance": cov,
+            },
+            "orientation_availability": 2,
+            "is_stationary": False,
+        },
+        "shape": {
+            "type": 0,
+            "footprint": {"points": [{"x": 1.0, "y": 2.0, "z": 0.0}] * (len(object_id) % 3)},
+            "dimensions": {"x": row["length"], "y": row["width"], "z": row["height"]},
+        },
+    }
+
+
+def write_tracked(
+    trace: LabelTrace,
+    path: Path,
+    origin_ns: int = 1_700_000_000_000_000_000,
+    drop: frozenset[int] = frozenset(),
+    late_tf: bool = False,
+) -> None:
+    """Write a trace as :data:`TRACKED_TOPIC` (TrackedObjects, boxes
+    in the ``base_link`` frame of the ego) and ``/tf`` (map <- base_link, the ego's pose), one of
+    each per frame, logged 20 ms after the frame's stamp. ``drop``: frame positions whose
+    TrackedObjects message is not written; ``late_tf``: each frame's /tf message is written after
+    the next frame's objects (out of order)."""
+    writer = BagWriter(path)
+    stamps = frame_stamps(trace, origin_ns)
+    ego = trace.object_index(trace.ego)
+    ex, ey, ez, eh = (trace.dense(c)[:, ego] for c in ("x", "y", "z", "heading"))
+    ez = np.nan_to_num(ez)
+    kinds = trace.objects.kinds()
+    offsets = trace.states.frame_offsets(trace.n_frames)
+    s = trace.states
+    pending_tf = None
+    for f in range(trace.n_frames):
+        ego_yaw = float(yaw_from_heading(eh[f]))
+        c, si = np.cos(ego_yaw), np.sin(ego_yaw)
+        tf = {
+            "transforms": [
+                {
+                    "header": {"stamp": _stamp(int(stamps[f])), "frame_id": "map"},
+                    "child_frame_id": "base_link",
+                    "transform": {
+                        "translation": {"x": float(ex[f]), "y": float(ey[f]), "z": float(ez[f])},
+                        "rotation": _quat(ego_yaw),
+                    },
+                }
+            ]
+        }
+        objects = []
+        for r in range(offsets[f], offsets[f + 1]):
+            o = int(s.object[r])
+            if o == ego:
+                continue
+            dx, dy, dz = s.x[r] - ex[f], s.y[r] - ey[f], np.nan_to_num(s.z[r]) - ez[f]
+            yaw = float(yaw_from_heading(s.heading[r]))
+            vx, vy = float(s.vx[r]), float(s.vy[r])
+            cb, sb = np.cos(yaw), np.sin(yaw)
+            row = {
+                "length": float(s.length[r]),
+                "width": float(s.width[r]),
+                "height": float(s.height[r]),
+                "velocity_body": {"x": cb * vx + sb * vy, "y": -sb * vx + cb * vy, "z": 0.0},
+            }
+            pose = {"x": c * dx + si * dy, "y": -si * dx + c * dy, "z": float(dz)}
+            objects.append(tracked_object(str(trace.objects.id[o]), str(kinds[o]), pose, yaw - ego_yaw, row))
+        log = int(stamps[f]) + 20_000_000
+        if not late_tf:
+            writer.write("/tf", "tf2_msgs/TFMessage", tf, log)
+        if f not in drop:
+            message = {"header": {"stamp": _stamp(int(stamps[f])), "frame_id": "base_link"}, "objects": objects}
+            writer.write(TRACKED_TOPIC, "autoware_perception_msgs/TrackedObjects", message, log)
+        if late_tf:
+            if pending_tf is not None:
+                writer.write("/tf", "tf2_msgs/TFMessage", *pending_tf)
+            pending_tf = (tf, log)
+    if pending_tf is not None:
+        writer.write("/tf", "tf2_msgs/TFMessage", *pending_tf)
+    writer.close()

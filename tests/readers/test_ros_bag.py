@@ -1,0 +1,202 @@
+"""ROS 2 bags (MCAP) of Autoware TrackedObjects + /tf written from real traces read back as the
+same traces; dropped, out-of-order, truncated, mistyped and unknown messages."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from scenegrep import readers
+from scenegrep.errors import UserError
+from scenegrep.model import LabelTrace, TraceSource, concatenate
+from scenegrep.model.geometry import heading_difference
+from scenegrep.readers.ros.bag import bag_messages
+from scenegrep.readers.ros.framing import BagOptions, FrameBuilder
+from scenegrep.readers.ros.reader import read_trace
+
+from .ros_writer import TRACKED_TOPIC as TOPIC
+from .ros_writer import BagWriter, frame_stamps, read_back_id, write_tracked
+
+AV2 = "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
+NUSCENES = "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl"
+ORIGIN = 1_700_000_000_000_000_000
+
+
+@pytest.fixture(scope="module")
+def av2(real_data, tmp_path_factory) -> tuple[LabelTrace, Path]:
+    trace = readers.read_trace(real_data / AV2)
+    path = tmp_path_factory.mktemp("bags") / "av2.mcap"
+    write_tracked(trace, path, ORIGIN)
+    return trace, path
+
+
+@pytest.fixture(scope="module")
+def short(av2, tmp_path_factory) -> tuple[LabelTrace, Path]:
+    """The first 25 frames of the AV2 log, the bag of the variant tests."""
+    trace = av2[0].slice_frames(0, 25)
+    return trace, tmp_path_factory.mktemp("short")
+
+
+def assert_same(original: LabelTrace, bag: LabelTrace, frames: np.ndarray | None = None) -> None:
+    """``bag`` holds ``original``'s frames (all, or the positions ``frames``): the same objects,
+    kinds, positions (1e-6 m), headings, sizes and velocities (the ego's pose only), times."""
+    if frames is not None:
+        keep = np.zeros(original.n_frames, dtype=bool)
+        keep[frames] = True
+        original = original.select_frames(keep)
+    assert bag.n_frames == original.n_frames
+    np.testing.assert_allclose(bag.frame_time, original.frame_time - original.frame_time[0], atol=1e-9)
+    ids = ["ego" if i == original.ego else read_back_id(i) for i in original.objects.id]
+    rows = bag.objects.row_of()
+    present = np.bincount(original.states.object, minlength=original.n_objects) > 0
+    assert sorted(rows) == sorted(np.array(ids)[present].tolist())
+    new_row = np.array([rows.get(i, -1) for i in ids])
+    kinds = dict(zip(bag.objects.id, bag.objects.kinds()))
+    for i, kind in zip(ids, original.objects.kinds()):
+        if i in kinds and i != "ego":
+            assert kinds[i] == kind, i
+    s = original.states
+    order = np.lexsort((new_row[s.object], s.frame))
+    b = bag.states
+    assert len(b) == len(s)
+    np.testing.assert_array_equal(b.frame, s.frame[order])
+    np.testing.assert_array_equal(b.object, new_row[s.object[order]])
+    for column in ("x", "y"):
+        np.testing.assert_allclose(getattr(b, column), getattr(s, column)[order], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(b.z, np.nan_to_num(s.z[order]), rtol=0, atol=1e-6)
+    assert np.abs(heading_difference(b.heading, s.heading[order])).max() < 1e-9
+    not_ego = b.object != rows["ego"]
+    for column in ("length", "width", "height", "vx", "vy"):
+        np.testing.assert_allclose(
+            getattr(b, column)[not_ego], getattr(s, column)[order][not_ego], rtol=0, atol=1e-6, equal_nan=True
+        )
+    assert np.isnan(b.length[~not_ego]).all()  # /tf carries no ego size
+
+
+def test_tracked_objects_and_tf_give_back_the_trace(av2):
+    trace, path = av2
+    bag = readers.read_trace(path)
+    assert readers.detect_format(path) == "ros-bag"
+    assert bag.ego == "ego" and bag.attributes["time_origin_ns"] == ORIGIN
+    assert_same(trace, bag)
+
+
+@pytest.mark.slow
+def test_nuscenes_scene_0061_gives_back_the_trace(real_data, tmp_path):
+    trace = readers.read_trace(real_data / NUSCENES)
+    write_tracked(trace, tmp_path / "n.mcap", ORIGIN)
+    assert_same(trace, readers.read_trace(tmp_path / "n.mcap"))
+
+
+def test_a_bag_directory_reads_as_its_mcap_file(av2, tmp_path):
+    trace, path = av2
+    (tmp_path / "metadata.yaml").write_text("rosbag2_bagfile_information:\n  storage_identifier: mcap\n")
+    (tmp_path / "rec_0.mcap").write_bytes(path.read_bytes())
+    assert readers.detect_format(tmp_path) == "ros-bag"
+    assert_same(trace, readers.read_trace(tmp_path))
+
+
+def test_fed_one_message_at_a_time_each_chunk_is_one_frame_and_all_is_the_offline_trace(short):
+    trace, folder = short
+    write_tracked(trace, folder / "late.mcap", ORIGIN, late_tf=True)  # each /tf after its frame's objects
+    builder = FrameBuilder(BagOptions(), "late", TraceSource(str(folder / "late.mcap"), "ros-bag"))
+    chunks = []
+    for message in bag_messages(folder / "late.mcap"):
+        chunk = builder.feed([message])
+        if chunk is not None:
+            assert chunk.n_frames == 1
+            chunks.append(chunk)
+    assert len(chunks) == trace.n_frames  # each frame once its /tf arrived, the last one too
+    assert builder.finish() is None
+    online = concatenate(chunks)
+    assert_same(trace, online)
+    assert online.equals(read_trace(folder / "late.mcap"))
+
+
+def test_dropped_messages_leave_out_their_frames(short):
+    trace, folder = short
+    write_tracked(trace, folder / "drop.mcap", ORIGIN, drop=frozenset({0, 7, 8}))
+    assert_same(trace, readers.read_trace(folder / "drop.mcap"), np.setdiff1d(np.arange(25), [0, 7, 8]))
+
+
+def test_frames_at_a_rate_hold_the_latest_message_of_each_window(short):
+    trace, folder = short
+    write_tracked(trace, folder / "rate.mcap", ORIGIN)
+    bag = read_trace(folder / "rate.mcap", BagOptions(rate=5.0))
+    stamps = frame_stamps(trace, ORIGIN)
+    window = (stamps - stamps[0]) // 200_000_000
+    latest = np.flatnonzero(np.r_[window[1:] != window[:-1], True])
+    np.testing.assert_allclose(bag.frame_time, np.unique(window) * 0.2)
+    objects = bag.states.object != bag.object_index("ego")
+    expected = trace.select_frames(np.isin(np.arange(25), latest))
+    np.testing.assert_allclose(
+        np.sort(bag.states.x[objects]),
+        np.sort(expected.states.x[expected.states.object != expected.object_index(expected.ego)]),
+        atol=1e-6,
+    )
+
+
+def test_a_missing_transform_names_the_topic_and_log_time(short, tmp_path):
+    trace, _ = short
+    path = tmp_path / "no_tf.mcap"
+    write_tracked(trace, path, ORIGIN)
+    kept = [m for m in bag_messages(path) if not (m.topic == "/tf" and m.log_time > frame_stamps(trace, ORIGIN)[20])]
+    rewritten = tmp_path / "cut.mcap"
+    _copy(kept, rewritten)
+    with pytest.raises(UserError) as error:
+        readers.read_trace(rewritten)
+    log_time = int(frame_stamps(trace, ORIGIN)[20]) + 20_000_000  # frame 20's /tf was logged after its stamp
+    assert f"topic {TOPIC}, message at log time {log_time} ns: no transform map <- base_link" in error.value.one_line()
+
+
+def test_unknown_types_are_skipped_with_a_note(short, tmp_path, capsys):
+    trace, _ = short
+    path = tmp_path / "unknown.mcap"
+    write_tracked(trace, path, ORIGIN)
+    messages = list(bag_messages(path))
+    point = messages[0]._replace(topic="/weird", schema_name="geometry_msgs/msg/Point", data=b"\0\1\0\0" + bytes(24))
+    _copy([point, *messages], tmp_path / "more.mcap", extra_schema=b"float64 x\nfloat64 y\nfloat64 z")
+    assert_same(trace, readers.read_trace(tmp_path / "more.mcap"))
+    assert (
+        "skipped topics of unsupported types: /weird (geometry_msgs/msg/Point, cdr encoding)" in capsys.readouterr().err
+    )
+
+
+@pytest.mark.parametrize("cut", [0.5, 0.999])
+def test_a_truncated_bag_is_a_one_line_error(av2, tmp_path, cut):
+    _, path = av2
+    data = path.read_bytes()
+    (tmp_path / "cut.mcap").write_bytes(data[: int(len(data) * cut)])
+    with pytest.raises(UserError) as error:
+        readers.read_trace(tmp_path / "cut.mcap")
+    assert "truncated or corrupt" in error.value.one_line() and "\n" not in error.value.one_line()
+
+
+def test_a_message_that_does_not_fit_its_schema_names_topic_and_log_time(short, tmp_path):
+    trace, _ = short
+    path = tmp_path / "bad.mcap"
+    write_tracked(trace, path, ORIGIN)
+    messages = list(bag_messages(path))
+    target = next(i for i, m in enumerate(messages) if m.topic == TOPIC and i > 10)
+    messages[target] = messages[target]._replace(data=messages[target].data[:200])
+    _copy(messages, tmp_path / "short.mcap")
+    with pytest.raises(UserError) as error:
+        readers.read_trace(tmp_path / "short.mcap")
+    assert f"topic {TOPIC}, message at log time {messages[target].log_time} ns: truncated" in error.value.one_line()
+
+
+def _copy(messages, path: Path, extra_schema: bytes | None = None) -> None:
+    """Write raw messages again (their schemas from the messages themselves)."""
+    writer = BagWriter(path)
+    mcap = writer.writer._writer
+    schemas: dict[str, int] = {}
+    channels: dict[str, int] = {}
+    for m in messages:
+        if m.topic not in channels:
+            data = extra_schema if m.topic == "/weird" else m.schema_data
+            schemas.setdefault(m.schema_name, mcap.register_schema(m.schema_name, "ros2msg", data))
+            channels[m.topic] = mcap.register_channel(m.topic, "cdr", schemas[m.schema_name])
+        mcap.add_message(channels[m.topic], m.log_time, m.data, m.log_time)
+    writer.close()

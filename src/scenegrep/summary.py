@@ -80,6 +80,10 @@ def describe(path: str | Path, with_map: bool = True) -> dict[str, Any]:
     format_name = readers.detect_format(path)
     spec = readers.FORMATS[format_name]
     out: dict[str, Any] = {"path": str(path), "format": format_name, "description": spec.description}
+    if format_name == "ros-bag":
+        from .readers.ros.bag import topic_table
+
+        out["topics"] = topic_table(path)
     traces = list(readers.read_traces(path, format_name)) if spec.traces else []
     out["traces"] = [trace_summary(t) for t in traces]
     if with_map:

@@ -13,7 +13,8 @@ from scenegrep.errors import UserError
 from scenegrep.model import LabelTrace, TraceSource, concatenate
 from scenegrep.model.geometry import heading_difference
 from scenegrep.readers.ros.bag import bag_messages
-from scenegrep.readers.ros.framing import BagOptions, FrameBuilder
+from scenegrep.readers.ros.framing import FrameBuilder
+from scenegrep.readers.ros.options import BagOptions
 from scenegrep.readers.ros.reader import read_trace
 
 from .ros_writer import TRACKED_TOPIC as TOPIC

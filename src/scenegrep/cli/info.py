@@ -11,6 +11,7 @@ import argparse
 import json
 from typing import Any
 
+from .bag_options import add_arguments as add_bag_arguments
 from .inputs import each_input
 
 
@@ -24,6 +25,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("paths", nargs="+", metavar="PATH", help="file or recording directory (- for stdin)")
     parser.add_argument("--json", action="store_true", help="print one JSON document per path")
     parser.add_argument("--no-map", action="store_true", help="do not load the traces' maps")
+    add_bag_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -45,6 +47,12 @@ def _trace_lines(t: dict[str, Any]) -> list[str]:
         lines.append(f"    image samples per channel: {_classes(t['image_samples_per_channel'])}")
         lines.append(f"    image boxes per class: {_classes(t['image_boxes_per_class'])}")
     return lines
+
+
+def _topic_line(t: dict[str, Any]) -> str:
+    rate = "" if t["rate_hz"] is None else f", {t['rate_hz']:.1f} Hz"
+    skipped = "" if t["decoded"] else " (not read: unsupported type)"
+    return f"  topic {t['topic']}: {t['type']} [{t['encoding']}], {t['messages']} messages{rate}{skipped}"
 
 
 def _map_lines(m: dict[str, Any]) -> list[str]:
@@ -73,6 +81,8 @@ def _print_summary(path: str, args: argparse.Namespace) -> None:
         print(json.dumps(summary))
         return
     print(f"{path}: {summary['description']} [{summary['format']}]")
+    for topic in summary.get("topics", []):
+        print(_topic_line(topic))
     for trace in summary["traces"]:
         print("\n".join(_trace_lines(trace)))
     for road_map in summary.get("maps", []):

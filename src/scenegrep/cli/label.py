@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from .bag_options import add_arguments as add_bag_arguments
 from .inputs import each_input
 from .layers import add_unknown_layers_argument, report_unknown_layers, unknown_layers_of
 
@@ -42,6 +43,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--json", action="store_true", help="print the statistics as JSON")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     add_unknown_layers_argument(parser)
+    add_bag_arguments(parser)
     parser.set_defaults(run=run)
 
 

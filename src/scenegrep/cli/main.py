@@ -98,7 +98,10 @@ def _run(argv: Sequence[str] | None) -> int:
         if args.command is None:
             parser.print_help()
             return EXIT_USER_ERROR
-        code = int(args.run(args))
+        from .bag_options import applied
+
+        with applied(args):
+            code = int(args.run(args))
         sys.stdout.flush()
         return code
     except UserError as exc:

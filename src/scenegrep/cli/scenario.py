@@ -18,6 +18,7 @@ import argparse
 from collections.abc import Iterator
 from typing import Any
 
+from .bag_options import add_arguments as add_bag_arguments
 from .dataset_run import RowPrinter, add_dataset_arguments, reject_dataset_only, run_query_command
 from .layers import report_unknown_layers, unknown_layers_of
 from .live import add_live_arguments, check_live_arguments
@@ -52,6 +53,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object per match")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
     add_dataset_arguments(parser)
+    add_bag_arguments(parser)
     parser.set_defaults(run=run)
 
 

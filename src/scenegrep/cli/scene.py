@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from .bag_options import add_arguments as add_bag_arguments
 from .dataset_run import add_dataset_arguments, run_query_command
 from .layers import add_unknown_layers_argument
 
@@ -40,6 +41,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--json", action="store_true", help="print the results table as JSON lines")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
     add_dataset_arguments(parser)
+    add_bag_arguments(parser)
     parser.set_defaults(run=run)
 
 

@@ -17,6 +17,7 @@ import json
 import sys
 from typing import Any
 
+from .bag_options import add_arguments as add_bag_arguments
 from .dataset_run import add_dataset_arguments, reject_dataset_only, run_query_command
 from .live import add_live_arguments, check_live_arguments
 from .main import EXIT_NO_MATCH
@@ -52,6 +53,7 @@ def add_parser(subparsers: Any) -> None:
     )
     add_live_arguments(parser)
     add_dataset_arguments(parser)
+    add_bag_arguments(parser)
     parser.set_defaults(run=run)
 
 

@@ -102,3 +102,30 @@ def bag_messages(path: str | Path) -> Iterator[RawMessage]:
     for file in storage_files(Path(path)):
         with open(file, "rb") as handle:
             yield from messages(handle, str(file))
+
+
+def topic_table(path: str | Path) -> list[dict]:
+    """Per topic of a bag, in order of first message: its type, message encoding, message count,
+    rate (Hz, from the first to the last log time; None under two messages) and whether
+    scenegrep decodes it."""
+    from .decoders import supported
+
+    table: dict[str, dict] = {}
+    for m in bag_messages(path):
+        row = table.get(m.topic)
+        if row is None:
+            row = table[m.topic] = {
+                "topic": m.topic,
+                "type": m.schema_name,
+                "encoding": m.message_encoding,
+                "messages": 0,
+                "first": m.log_time,
+                "last": m.log_time,
+                "decoded": supported(m.schema_name, m.message_encoding),
+            }
+        row["messages"] += 1
+        row["first"], row["last"] = min(row["first"], m.log_time), max(row["last"], m.log_time)
+    for row in table.values():
+        span = row.pop("last") - row.pop("first")
+        row["rate_hz"] = (row["messages"] - 1) * 1e9 / span if row["messages"] > 1 and span > 0 else None
+    return list(table.values())

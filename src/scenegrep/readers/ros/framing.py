@@ -44,6 +44,7 @@ from .cdr import CdrError
 from .decoders import BOX_TYPES, LINK_TYPES, decode_cdr, supported, type_key
 from .messages import Boxes, RawMessage
 from .msgdef import DefinitionError
+from .options import BagOptions
 from .transforms import MissingTransform, TfBuffer, quat_multiply, quat_rotate, yaw_of
 
 EGO_ID = "ego"
@@ -54,25 +55,6 @@ STATIC_TOPIC = "/tf_static"
 
 MAX_MESSAGE_BYTES = 256 << 20
 """The largest message decoded (a TrackedObjects message of 1,000 objects is about 500 kB)."""
-
-
-@dataclass(frozen=True)
-class BagOptions:
-    """How messages become frames (see the module docstring): ``topics`` to read (empty: every
-    supported topic; ``/tf`` and ``/tf_static`` are always read), ``frame_topic`` or ``rate``
-    (Hz, not both), the ``map_frame`` and the ego's ``ego_frame``."""
-
-    topics: tuple[str, ...] = ()
-    frame_topic: str | None = None
-    rate: float | None = None
-    map_frame: str = "map"
-    ego_frame: str = "base_link"
-
-    def __post_init__(self) -> None:
-        if self.rate is not None and self.frame_topic is not None:
-            raise UserError("give --rate or --frame-topic, not both")
-        if self.rate is not None and not (0.001 <= self.rate <= 10_000):
-            raise UserError(f"--rate {self.rate}: a frame rate from 0.001 to 10000 Hz")
 
 
 @dataclass

@@ -3,7 +3,7 @@
 :func:`iter_chunks` runs the incremental pipeline (:mod:`.framing`) over a bag's messages in
 batches and yields each chunk of completed frames; :func:`read_trace` is that run to the end,
 its chunks concatenated. Options (topics, frame topic or rate, map and ego frames) are a
-:class:`BagOptions`.
+:class:`BagOptions`, by default those in force (:func:`.options.current`).
 """
 
 from __future__ import annotations
@@ -15,8 +15,9 @@ from pathlib import Path
 from ...errors import UserError, at
 from ...model import LabelTrace, TraceSource, concatenate
 from .bag import bag_messages
-from .framing import BagOptions, frames
+from .framing import frames
 from .messages import RawMessage
+from .options import BagOptions, current
 
 FORMAT = "ros-bag"
 
@@ -36,12 +37,18 @@ def iter_chunks(
 ) -> Iterator[LabelTrace]:
     """The chunks of frames of a bag, as the pipeline completes them."""
     source = TraceSource(str(path), FORMAT)
-    yield from frames(batches(bag_messages(path)), options or BagOptions(), Path(path).stem, source, note)
+    yield from frames(batches(bag_messages(path)), options or current(), Path(path).stem, source, note)
+
+
+def read_traces(path: str | Path, options: BagOptions | None = None) -> Iterator[LabelTrace]:
+    """The bag's trace, or nothing when it holds no box message to build a frame from."""
+    chunks = list(iter_chunks(path, options))
+    if chunks:
+        yield concatenate(chunks)
 
 
 def read_trace(path: str | Path, options: BagOptions | None = None) -> LabelTrace:
     """The whole bag as one trace (UserError when no frame could be built)."""
-    chunks = list(iter_chunks(path, options))
-    if not chunks:
-        raise UserError("no frames: the bag holds no messages of a supported box type (see scenegrep info)", at(path))
-    return concatenate(chunks)
+    for trace in read_traces(path, options):
+        return trace
+    raise UserError("no frames: the bag holds no messages of a supported box type (see scenegrep info)", at(path))

@@ -3,12 +3,14 @@ same traces; dropped, out-of-order, truncated, mistyped and unknown messages."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from scenegrep import readers
+from scenegrep.cli.main import main
 from scenegrep.errors import UserError
 from scenegrep.model import LabelTrace, TraceSource, concatenate
 from scenegrep.model.geometry import heading_difference
@@ -201,3 +203,18 @@ def _copy(messages, path: Path, extra_schema: bytes | None = None) -> None:
             channels[m.topic] = mcap.register_channel(m.topic, "cdr", schemas[m.schema_name])
         mcap.add_message(channels[m.topic], m.log_time, m.data, m.log_time)
     writer.close()
+
+
+def test_info_lists_topics_and_the_options_reach_the_reader(av2, capsys):
+    _, path = av2
+    assert main(["info", "--json", str(path)]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    topics = {t["topic"]: t for t in summary["topics"]}
+    assert topics[TOPIC]["messages"] == 156 and topics["/tf"]["type"] == "tf2_msgs/msg/TFMessage"
+    assert topics[TOPIC]["rate_hz"] == pytest.approx(155 / (summary["traces"][0]["duration_s"]), rel=1e-3)
+    assert main(["info", "--json", str(path), "--rate", "2", "--ego-frame", "none"]) == 0
+    trace = json.loads(capsys.readouterr().out)["traces"][0]
+    assert trace["frames"] == 31 and trace["ego"] is None
+    assert main(["info", str(path), "--rate", "2", "--frame-topic", TOPIC]) == 2
+    assert "give --rate or --frame-topic, not both" in capsys.readouterr().err
+    assert main(["info", str(path), "--rate", "nan"]) == 2

@@ -1,6 +1,8 @@
 """The records of the bag pipeline: raw messages in, decoded boxes and transforms out.
 
-A :class:`RawMessage` is one message as a bag or MCAP stream holds it. Decoders turn a batch of
+A :class:`RawMessage` is one message as a bag or MCAP stream holds it (the record
+:mod:`scenegrep.readers.mcap_follow` yields while following a growing file, so the live
+reader feeds this pipeline as is). Decoders turn a batch of
 raw messages of one type into :class:`Boxes` (3-D objects, poses in their message's frame) or
 :class:`Transforms` (time-stamped frame links, from ``/tf`` or an odometry topic). Times are
 integer nanoseconds; lengths metres; quaternions (x, y, z, w).
@@ -9,22 +11,11 @@ integer nanoseconds; lengths metres; quaternions (x, y, z, w).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
-
 import numpy as np
 
+from ..mcap_follow import RawMessage
 
-class RawMessage(NamedTuple):
-    """One message: its topic, schema (name, encoding, definition bytes), message encoding,
-    log time (ns) and serialised bytes."""
-
-    topic: str
-    schema_name: str
-    schema_encoding: str
-    schema_data: bytes
-    message_encoding: str
-    log_time: int
-    data: bytes
+__all__ = ["Boxes", "RawMessage", "Transforms"]
 
 
 @dataclass(frozen=True)

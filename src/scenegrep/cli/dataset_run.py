@@ -28,11 +28,14 @@ from .layers import report_unknown_layers
 from .main import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
 
 
-def add_dataset_arguments(parser: argparse.ArgumentParser) -> None:
-    """The options of the results table and of a run over a dataset."""
-    group = parser.add_argument_group("results table (also over files) and datasets (scenegrep ingest)")
-    group.add_argument("--output", metavar="FILE", help="also write the results table to this Parquet file")
-    group.add_argument("--csv", action="store_true", help="print the results table as CSV")
+def add_dataset_arguments(parser: argparse.ArgumentParser, results_table: bool = True) -> None:
+    """The options of a run over a dataset and (``results_table``) of the results table."""
+    if results_table:
+        group = parser.add_argument_group("results table (also over files) and datasets (scenegrep ingest)")
+        group.add_argument("--output", metavar="FILE", help="also write the results table to this Parquet file")
+        group.add_argument("--csv", action="store_true", help="print the results table as CSV")
+    else:
+        group = parser.add_argument_group("datasets (scenegrep ingest)")
     group.add_argument("--dataset", metavar="DATASET", help="query every trace of an ingested dataset")
     group.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes (default: all cores)")
     group.add_argument("--engine", choices=["local", "ray"], default="local", help="local processes or Ray")
@@ -63,10 +66,7 @@ def run_query_command(
     if getattr(args, "map", None):
         readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
     printer = RowPrinter(args)
-    if args.dataset:
-        results, where = _over_dataset(args, spec, paths, printer)
-    else:
-        results, where = _over_files(args, spec, paths, printer), ""
+    results, where = results_of(args, spec, paths, printer)
     if args.output:
         results.write_parquet(args.output)
     counts = results.counts()
@@ -81,6 +81,16 @@ def run_query_command(
     if counts["failed"]:
         return EXIT_SOME_FAILED
     return 0 if counts["matched"] else EXIT_NO_MATCH
+
+
+def results_of(
+    args: argparse.Namespace, spec: Any, paths: list[str], printer: Callable[[list[dict[str, Any]]], None]
+) -> tuple[Any, str]:
+    """The results of ``spec`` over ``paths`` or over ``args.dataset`` (one engine either way), each
+    trace's rows shown to ``printer``, and where a dataset run keeps them ("" over files)."""
+    if args.dataset:
+        return _over_dataset(args, spec, paths, printer)
+    return _over_files(args, spec, paths, printer), ""
 
 
 def _over_files(args: argparse.Namespace, spec: Any, paths: list[str], printer: RowPrinter) -> Any:
@@ -150,15 +160,18 @@ def _over_dataset(args: argparse.Namespace, spec: Any, paths: list[str], printer
 class RowPrinter:
     """Prints result rows as the options ask: text lines for matches (and, with ``--explain``,
     the explanation of traces without one), or every row as JSON or CSV; failed rows' errors on
-    stderr; nothing with ``-q``. ``--max-count N`` prints at most N matches per trace."""
+    stderr; nothing with ``-q``. ``--max-count N`` prints at most N matches per trace. With
+    ``failures_only`` it prints only the failed rows' errors."""
 
-    def __init__(self, args: argparse.Namespace):
+    def __init__(self, args: argparse.Namespace, failures_only: bool = False):
         from ..dataset.results import csv_writer
 
         self.args = args
+        self.failures_only = failures_only
         self.limit = getattr(args, "max_count", None)
         self.explain = getattr(args, "explain", False)
-        self.write_csv = csv_writer(sys.stdout) if args.csv and not args.quiet else None
+        wants_csv = getattr(args, "csv", False) and not failures_only
+        self.write_csv = csv_writer(sys.stdout) if wants_csv and not args.quiet else None
 
     def __call__(self, rows: list[dict[str, Any]]) -> None:
         """Print one trace's rows (or a whole table's)."""
@@ -169,6 +182,8 @@ class RowPrinter:
         for row in rows:
             if row["status"] == "failed":
                 print(f"scenegrep: failed: {row['name']}: {row['error']}", file=sys.stderr)
+            if self.failures_only:
+                continue
             if self.limit is not None and row["match"] >= self.limit:
                 continue
             if self.write_csv is not None:

@@ -22,6 +22,7 @@ from ..errors import UserError  # noqa: E402
 from ..terminal import EscapingStream, OutputError  # noqa: E402
 
 COMMANDS = (
+    "coverage",
     "evaluate",
     "export",
     "info",

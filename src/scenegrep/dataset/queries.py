@@ -11,7 +11,10 @@ and last frame, inclusive), ``start_time``/``end_time`` (seconds from the trace'
 ``time_origin_ns`` (the trace's absolute time 0), ``explanation`` (with ``explain``: the
 witness of a match or why the trace does not match; for pruned traces, why), ``error``, and
 ``values`` (scene matches with ``values``: JSON object of the program's random variables' values
-that reproduce the frame, and each soft requirement's truth), and ``objects`` (JSON object,
+that reproduce the frame, and each soft requirement's truth), ``intervals`` (scene matches, and
+the initial scene of scenario matches, with ``intervals``: JSON object of every value of each
+random variable that reproduces the (first) frame, as intervals; see
+:meth:`scenegrep.scene.projection.FrameValues.to_json`), and ``objects`` (JSON object,
 program object -> ``{"id", "start_frame", "end_frame", "start_time", "end_time"}``: the labeled
 object it corresponds to and the frames, inclusive, and times (s) in which it is involved; see
 :func:`involvement`).
@@ -56,6 +59,7 @@ RESULTS_SCHEMA = pa.schema(
         ("error", pa.string()),
         ("values", pa.string()),
         ("objects", pa.string()),
+        ("intervals", pa.string()),
     ]
 )
 
@@ -73,6 +77,7 @@ OPTIONS: dict[str, dict[str, Any]] = {
         "vocabulary": None,
         "all": False,
         "explain": False,
+        "intervals": False,
         "unknown_layers": None,
     },
     "scene": {
@@ -84,6 +89,7 @@ OPTIONS: dict[str, dict[str, Any]] = {
         "exact": False,
         "explain": False,
         "values": False,
+        "intervals": False,
         "unknown_layers": None,
     },
     "spre": {"compat": False, "space": None, "channels": None, "skip": 0},
@@ -279,6 +285,8 @@ def _scene_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: RoadMa
         if spec.option("values"):
             soft = {name: bool(holds[number]) for name, holds in result.soft.items()}
             row["values"] = json.dumps(result.values(frame) | soft, allow_nan=True)
+        if spec.option("intervals"):
+            row["intervals"] = json.dumps(result.recovered[number].to_json(), allow_nan=True)
         rows.append(row)
     if spec.option("explain"):
         rows.extend(
@@ -294,18 +302,22 @@ def _scenario_rows(spec: QuerySpec, query: Any, trace: LabelTrace, road_map: Roa
 
         trace = label_trace(trace, road_map, unknown_layers=spec_choice(spec)).trace
     result = query.match(trace, spec.option("window"), road_map, scenario_options(spec))
-    return scenario_rows(result, spec.option("all"), spec.option("explain"))
+    return scenario_rows(result, spec.option("all"), spec.option("explain"), spec.option("intervals"))
 
 
-def scenario_rows(result: Any, find_all: bool, explain: bool) -> list[dict[str, Any]]:
+def scenario_rows(result: Any, find_all: bool, explain: bool, intervals: bool = False) -> list[dict[str, Any]]:
     """The rows of a scenario query's result on one trace (empty: no match, unless ``explain``):
-    every window with ``find_all``, else the first."""
+    every window with ``find_all``, else the first; with ``intervals``, the recovered values of
+    each window's initial scene."""
     trace = result.trace
     rows = []
     for number, (match, first, last) in enumerate(result.windows()):
         row = _window(trace, number, first, last, match.correspondence)
         if explain:
             row["explanation"] = "\n".join(result.explain(result.matches.index(match), first))
+        if intervals:
+            scene = result.initial_scene(result.matches.index(match), first)
+            row["intervals"] = json.dumps(scene.recovered[0].to_json(), allow_nan=True)
         rows.append(row)
         if not find_all:
             break

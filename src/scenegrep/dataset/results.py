@@ -131,10 +131,10 @@ class Results:
             pq.write_table(self.table.replace_schema_metadata(metadata), tmp, compression="zstd")
 
 
-LATER_COLUMNS = ("values", "objects")
+LATER_COLUMNS = ("values", "objects", "intervals")
 """Columns added after results files were first written: null when a file lacks them."""
 
-JSON_COLUMNS = ("correspondence", "values", "objects")
+JSON_COLUMNS = ("correspondence", "values", "objects", "intervals")
 """Columns holding JSON text, written as JSON values in JSON lines."""
 
 

@@ -84,6 +84,12 @@ class ScenarioResult:
         found = self.matches[match]
         return self.explainer.witness(found.correspondence, int(found.starts[0] if start is None else start))
 
+    def initial_scene(self, match: int, start: int) -> SceneResult:
+        """The initial scene of match number ``match`` checked at frame position ``start`` with the
+        match's correspondence (the scene engine's check that admitted the window)."""
+        found = self.matches[match]
+        return self.explainer.scene_at(found.correspondence, np.array([start]))
+
     def why_not(self) -> str:
         """For a trace without a match: the furthest frame reached and what failed there."""
         return self.explainer.why_not()

@@ -304,3 +304,52 @@ def _holds(constraints: list[Linear], row: int, value: float) -> bool:
         elif not c.lo[row] <= v <= c.hi[row]:
             return False
     return True
+
+
+def closed_form_intervals(
+    ev: Evaluator, group: Group, tolerance: Tolerance
+) -> dict[Term, tuple[np.ndarray, np.ndarray]] | None:
+    """Per unknown, the lowest and highest value (arrays over the evaluator's current rows) that
+    satisfies each row's constraints, where a closed form applies: exact for one unknown in
+    affine constraints with at most one heading constraint modulo 2π (the hull of its feasible
+    values); for a random point pinned by the position features, the tolerance box of its
+    coordinates (an outer bound: the point's region may cut the box). None otherwise. Rows that
+    are not feasible get meaningless values (the caller masks them)."""
+    try:
+        constraints = _linear_constraints(ev, group, tolerance)
+    except NotAffine:
+        return None
+    scalars = {u for c in constraints for u in c.form.coefs}
+    points = {u.value[0] for u in ev.unknowns if u.op == "point"}
+    if not points and len(scalars) == 1:
+        (u,) = scalars
+        _, low, high, angles = _unknown_interval(ev, constraints)
+        if len(angles) > 1:
+            return None
+        for c, coef in angles:
+            low, high = _angle_hull(c, coef, low, high)
+        return {u: (low, high)}
+    pinned = _pinned_box(ev, constraints, points)
+    if pinned is None:
+        return None
+    (x_lo, x_hi), (y_lo, y_hi), _, _ = pinned
+    px, py = sorted(ev.unknowns, key=lambda u: u.value[1])
+    return {px: (x_lo, x_hi), py: (y_lo, y_hi)}
+
+
+def _angle_hull(c: Linear, coef: np.ndarray, low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The hull of the values u in [low, high] for which ``coef * u + const`` lies in the heading
+    window [c.lo, c.hi] modulo 2π: the window's first entry at or after the lowest value the term
+    takes, and its last exit at or before the highest (rows where coef is 0 keep [low, high])."""
+    ends = (coef * low + c.form.const, coef * high + c.form.const)
+    v_lo, v_hi = np.minimum(*ends), np.maximum(*ends)
+    width = c.hi - c.lo
+    with np.errstate(invalid="ignore"):
+        inside_lo = (np.mod(v_lo - c.lo, TWO_PI) <= width) | (width >= TWO_PI)
+        inside_hi = (np.mod(v_hi - c.lo, TWO_PI) <= width) | (width >= TWO_PI)
+        first = np.where(inside_lo | ~np.isfinite(v_lo), v_lo, v_lo + np.mod(c.lo - v_lo, TWO_PI))
+        last = np.where(inside_hi | ~np.isfinite(v_hi), v_hi, v_hi - np.mod(v_hi - c.hi, TWO_PI))
+    turning = coef != 0
+    safe = np.where(turning, coef, 1.0)
+    a, b = (first - c.form.const) / safe, (last - c.form.const) / safe
+    return np.where(turning, np.minimum(a, b), low), np.where(turning, np.maximum(a, b), high)

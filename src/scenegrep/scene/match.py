@@ -61,6 +61,7 @@ class TraceMatches:
     groups: list[Group]
     survivors: Rows
     notes: Counter = field(default_factory=Counter)
+    every: Rows | None = None
 
 
 class Candidates:
@@ -171,8 +172,9 @@ def match_trace(
         _record_failures(failed, rows, len(groups))
     matched = np.zeros(trace.n_frames, dtype=bool)
     matched[rows.frame] = True
+    rows = rows.take(np.argsort(rows.frame, kind="stable"))
     survivors = rows.take(np.unique(rows.frame, return_index=True)[1])
-    return TraceMatches(matched, _correspondences(survivors, trace), failed, groups, survivors, notes)
+    return TraceMatches(matched, _correspondences(survivors, trace), failed, groups, survivors, notes, rows)
 
 
 def _record_failures(failed: np.ndarray, rows: Rows, g: int) -> None:

@@ -27,6 +27,7 @@ from .dependencies import Group, analyse
 from .geometry import MapGeometry, geometry_of
 from .evaluate import Labels
 from .explain import soft_requirements, witness_values
+from .projection import FrameValues, frame_values
 from .needs import check_layers, free_fields, term_regions
 from .match import SceneOptions, TraceMatches, labels_of, match_trace
 from .program import Requirement, SceneProgram
@@ -73,6 +74,12 @@ class SceneResult:
         return witness_values(
             self.query.program, self.matches, self.labels, self.geometry, self.options.tolerance, survivor
         )
+
+    @cached_property
+    def recovered(self) -> list[FrameValues]:
+        """Every value of each random variable that reproduces a matched frame, as intervals, per
+        matched frame in frame order (see :mod:`.projection`)."""
+        return frame_values(self.query.program, self.matches, self.labels, self.geometry, self.options.tolerance)
 
     @cached_property
     def soft(self) -> dict[str, np.ndarray]:

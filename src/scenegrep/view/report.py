@@ -33,17 +33,27 @@ def write_report(source: ResultsSource, path: str | Path, progress: Callable[[It
     """Write the report of ``source`` to ``path`` and the views of its matched traces beside it;
     returns the number of views written. ``progress`` wraps the loop over the views (a bar)."""
     path = Path(path)
-    folder = path.with_name(f"{path.stem}_views")
+    written, link = write_views(source, path, progress)
+    page = report_page(source, link)
+    with atomic_path(path) as tmp:
+        tmp.write_text(page, encoding="utf-8")
+    return written
+
+
+def write_views(
+    source: ResultsSource, page: Path, progress: Callable[[Iterable], Iterable] = iter
+) -> tuple[int, Callable[[str, int], str]]:
+    """Write the view of every matched trace of ``source`` into ``<stem>_views/`` beside the page
+    ``page`` (each linking back to it); returns how many, and ``link(trace_id, match_number)``:
+    the address, relative to the page, of a match's view."""
+    folder = page.with_name(f"{page.stem}_views")
     written = 0
     for trace_id in progress(source.matched_trace_ids()):
         view = source.view(trace_id)
         with atomic_path(folder / view_file(view.trace_id)) as tmp:
-            tmp.write_text(view_page(view, back_link=f"../{path.name}"), encoding="utf-8")
+            tmp.write_text(view_page(view, back_link=f"../{page.name}"), encoding="utf-8")
         written += 1
-    page = report_page(source, lambda trace_id, number: f"{folder.name}/{view_file(trace_id)}#match={number}")
-    with atomic_path(path) as tmp:
-        tmp.write_text(page, encoding="utf-8")
-    return written
+    return written, lambda trace_id, number: f"{folder.name}/{view_file(trace_id)}#match={number}"
 
 
 def report_page(source: ResultsSource, link: Callable[[str, int], str]) -> str:

@@ -52,6 +52,11 @@ class ResultsSource:
         return cls.of_run(root, results)
 
     @classmethod
+    def of_results(cls, results: Results, dataset: Path | None) -> ResultsSource:
+        """Results just computed: a run over the dataset at ``dataset``, or (None) a query over files."""
+        return cls(results, None, recorded_query(results.query)) if dataset is None else cls.of_run(dataset, results)
+
+    @classmethod
     def of_run(cls, root: Path, results: Results) -> ResultsSource:
         """A run's results over the dataset at ``root``."""
         return cls(results, root, query_of(root, results.run_id) or recorded_query(results.query))

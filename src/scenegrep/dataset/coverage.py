@@ -304,6 +304,7 @@ def _assign(axis: Axis, lo: np.ndarray, hi: np.ndarray, chosen: list | None) -> 
         )
     edges = axis.edges
     k = np.clip(np.searchsorted(edges, lo, side="right") - 1, 0, axis.bins - 1)
-    inside = (lo >= edges[0]) & (hi <= edges[k + 1]) & (lo <= hi)
+    last = k == axis.bins - 1
+    inside = (lo >= edges[0]) & (lo <= hi) & ((hi < edges[k + 1]) | (last & (hi <= edges[-1])))
     found = np.where(inside, k, AMBIGUOUS)
     return np.where(np.isnan(lo) | np.isnan(hi), NO_VALUE, found)

@@ -9,11 +9,13 @@ values is computed:
   affine constraints (at most one heading constraint, modulo 2π):
   :func:`.decide.closed_form_intervals`;
 * for a random point pinned by the position features: its tolerance box;
-* otherwise by bisection with the row's decision procedure (:func:`.solvers.solve`): is the row
-  still feasible with the unknown restricted to [start, middle]? At most :data:`STEPS` steps
-  per end, from the box interval contraction gives. A verdict other than a proof of
-  infeasibility counts as feasible, so the interval is an outer bound of the projection (the
-  true one lies inside), within (box width) / 2**STEPS of it.
+* otherwise with the row's decision procedure (:func:`.solvers.solve`): is the row still
+  feasible with the unknown restricted to [start, v]? First with v just below the witness's value
+  (:data:`NEAR`; one call settles the usual case of a tiny interval), else by bisection, at most
+  :data:`STEPS` steps per end, within the box interval contraction gives. A verdict other than a
+  proof of infeasibility counts as feasible, so the interval is an outer bound of the
+  projection (the true one lies inside), within NEAR of the box width (or (box width) /
+  2**STEPS) of it.
 
 A frame's interval of a variable is the hull (not the union) of its intervals over the frame's
 correspondences and the alternatives of its ``Options`` choices; for an ``Options`` choice it is
@@ -45,6 +47,11 @@ MAX_CORRESPONDENCES = 16
 
 STEPS = 14
 """Bisection steps per end of an interval that no closed form gives."""
+
+NEAR = 1e-4
+NEAREST = 1e-2
+"""How far below (above) a witness value a bisection first looks for a feasible value: this part of
+the search width, at most NEAREST (m, rad or the variable's unit)."""
 
 LIMIT = 1e9
 """Ends beyond ±LIMIT are reported as unbounded."""
@@ -147,6 +154,7 @@ def _bisected(problem: Problem, geometry: MapGeometry, tolerance: Tolerance) -> 
     search = BranchAndPrune(problem, geometry, max(tolerance.position, tolerance.heading))
     box = search.initial_box()
     box = None if box is None else search.contract(box)
+    witness = solve(problem, geometry, tolerance).witness or {}
     found = {}
     for u in problem.unknowns:
         start = -LIMIT if box is None else max(box[u].lo, -LIMIT)
@@ -163,12 +171,26 @@ def _bisected(problem: Problem, geometry: MapGeometry, tolerance: Tolerance) -> 
             )
             return solve(restricted, geometry, tolerance).feasible
 
-        found[u] = (_lowest(feasible, start, end), -_lowest(lambda a, b: feasible(-b, -a), -end, -start))
+        value = witness.get(u)
+        mirrored = None if value is None else -value
+        found[u] = (
+            _lowest(feasible, start, end, value),
+            -_lowest(lambda a, b: feasible(-b, -a), -end, -start, mirrored),
+        )
     return found
 
 
-def _lowest(feasible, start: float, end: float) -> float:
-    """A lower bound, within (end - start) / 2**STEPS, of the lowest feasible value in [start, end]."""
+def _lowest(feasible, start: float, end: float, witness: float | None) -> float:
+    """A lower bound of the lowest feasible value in [start, end]: ``witness - step`` when nothing
+    below it is feasible (a witness is a feasible value; step = :data:`NEAR` of the width, at most
+    :data:`NEAREST`), else within (end - start) / 2**STEPS of it by bisection."""
+    step = min(NEAR * (end - start), NEAREST)
+    if witness is not None and math.isfinite(witness):
+        if witness - step <= start:
+            return start
+        if not feasible(start, witness - step):
+            return witness - step
+        end = witness - step
     low, high = start, end
     for _ in range(STEPS):
         middle = (low + high) / 2

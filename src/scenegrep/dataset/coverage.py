@@ -105,7 +105,7 @@ class Axis:
         if self.edges is None:
             return f"option {k + 1} of {self.size}"
         lo, hi = self.bounds(k)
-        return f"[{lo:.4g}, {hi:.4g}{']' if k == self.bins - 1 else ')'}"
+        return f"[{lo:.6g}, {hi:.6g}{']' if k == self.bins - 1 else ')'}"
 
     def domain_text(self) -> str:
         d = self.declared

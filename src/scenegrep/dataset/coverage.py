@@ -6,15 +6,17 @@ random variable, :mod:`scenegrep.scene.projection`) and the program's declared r
 its declared domain: a ``Range``/``TruncatedNormal`` with constant ends over [low, high] in
 ``bins`` equal bins; a variable without constant finite ends (``Normal``, ends that depend on
 other values) over the extent of its recovered values; a random point as two axes (x and y, m)
-over the extent of its recovered coordinates; an ``Options`` choice one bin per alternative.
+over the extent of its recovered coordinates (one bin when that extent is at most twice the
+widest recovered interval: the values cannot be told apart more finely); an ``Options``
+choice one bin per alternative.
 
 A match's recovered value is an interval (several values reproduce the frame: tolerances,
 several correspondences); it *covers* a bin only when the whole interval lies in the bin
 (bins are [lo, hi), the last [lo, hi]); an interval over several bins covers none and the match
 counts as ambiguous for that variable; an ``Options`` value covers its alternative only when
 one alternative alone reproduces the frame. Bins no match covers are *gaps*. Two axes' joint
-coverage counts the matches that cover one bin of each. Everything is also broken down by the
-results' ``source`` (the input file or the ingested source).
+coverage counts the matches that cover one bin of each. Each axis's bins are also broken down by
+the results' ``source`` (the input file or the ingested source).
 """
 
 from __future__ import annotations
@@ -35,7 +37,9 @@ MAX_BINS = 200
 """Most bins per axis a user may ask for."""
 
 MAX_PAIR_AXES = 8
-"""Joint coverage is computed for the pairs of the first this many axes."""
+MAX_PAIR_BINS = 50
+"""Joint coverage is computed for the pairs of the first MAX_PAIR_AXES axes with at most
+MAX_PAIR_BINS bins each (a pair's table rows and heat map grow with the product)."""
 
 AMBIGUOUS = -1
 """Bin of a match whose interval spans several bins (or several alternatives)."""
@@ -60,7 +64,9 @@ TABLE_SCHEMA = pa.schema(
     ]
 )
 """The coverage table: one row per bin of each axis (``variable2`` null) and per cell of each
-pair of axes, for all sources (``source`` null) and for each source; ``matches`` covering it."""
+pair of axes (:meth:`Coverage.pairs`), over all sources (``source`` null), and one per bin of
+each axis that a source's matches cover (``source`` set); ``matches`` covering it, ``gap``
+when none does."""
 
 
 def checked_bins(bins: int) -> int:
@@ -153,8 +159,8 @@ class Coverage:
 
     def pairs(self) -> list[tuple[int, int]]:
         """The pairs of axes whose joint coverage is reported (of the first :data:`MAX_PAIR_AXES`)."""
-        first = min(len(self.axes), MAX_PAIR_AXES)
-        return [(a, b) for a in range(first) for b in range(a + 1, first)]
+        chosen = [a for a, axis in enumerate(self.axes) if axis.bins <= MAX_PAIR_BINS][:MAX_PAIR_AXES]
+        return [(a, b) for i, a in enumerate(chosen) for b in chosen[i + 1 :]]
 
     def matches_in(self, a: int, k: int) -> list[int]:
         """The match rows (indices into ``rows``) covering bin ``k`` of axis ``a``."""
@@ -179,14 +185,14 @@ class Coverage:
         for source in [None, *self.sources]:
             for a, axis in enumerate(self.axes):
                 for k, n in enumerate(self.counts(a, source).tolist()):
-                    lo, hi = axis.bounds(k)
-                    out.append(_row(axis.name, None, source, k, None, lo, hi, None, None, axis.label(k), n))
-            for a, b in self.pairs():
-                cells = self.joint(a, b, source)
-                for (i, j), n in np.ndenumerate(cells):
-                    (lo, hi), (lo2, hi2) = self.axes[a].bounds(i), self.axes[b].bounds(j)
-                    label = f"{self.axes[a].label(i)} × {self.axes[b].label(j)}"
-                    out.append(_row(self.axes[a].name, self.axes[b].name, source, i, j, lo, hi, lo2, hi2, label, n))
+                    if n or source is None:
+                        lo, hi = axis.bounds(k)
+                        out.append(_row(axis.name, None, source, k, None, lo, hi, None, None, axis.label(k), n))
+        for a, b in self.pairs():
+            for (i, j), n in np.ndenumerate(self.joint(a, b)):
+                (lo, hi), (lo2, hi2) = self.axes[a].bounds(i), self.axes[b].bounds(j)
+                label = f"{self.axes[a].label(i)} × {self.axes[b].label(j)}"
+                out.append(_row(self.axes[a].name, self.axes[b].name, None, i, j, lo, hi, lo2, hi2, label, n))
         return pa.Table.from_pylist(out, schema=TABLE_SCHEMA)
 
     def write(self, path: str) -> None:
@@ -290,7 +296,8 @@ def _axis(variable: Declared, suffix: str, lo: np.ndarray, hi: np.ndarray, bins:
     if not len(ends):
         return None
     first, last = float(ends.min()), float(ends.max())
-    if last == first:
+    widths = (hi - lo)[np.isfinite(hi - lo)]
+    if last - first <= 2 * (widths.max() if len(widths) else 0.0):
         return Axis(name, variable, np.array([first, last]), 0, "recovered")
     return Axis(name, variable, np.linspace(first, last, bins + 1), 0, "recovered")
 

@@ -91,58 +91,77 @@ def frame_values(
     frames, first, counts = np.unique(every.frame, return_index=True, return_counts=True)
     rank = np.arange(len(every)) - np.repeat(first, counts)
     rows = every.take(np.flatnonzero(rank < MAX_CORRESPONDENCES))
-    slot = np.searchsorted(frames, rows.frame)
-    found = [FrameValues(int(n)) for n in counts]
+    hulls = _Hulls(len(frames), unique_names(matches.groups))
     objects = {o.name: o for o in program.objects}
-    names = unique_names(matches.groups)
     for group in matches.groups:
         if group.unknowns and len(rows):
             ev = Evaluator(rows, labels, objects, geometry, position_tolerance=tolerance.position)
-            _group_values(ev, group, tolerance, slot, found, names)
-    return found
+            _group_values(ev, group, tolerance, np.searchsorted(frames, rows.frame), hulls)
+    return hulls.frames(counts)
 
 
-def _group_values(
-    ev: Evaluator,
-    group: Group,
-    tolerance: Tolerance,
-    slot: np.ndarray,
-    found: list[FrameValues],
-    names: dict[Any, str],
-) -> None:
-    """Add one group's values of every row to its frame's :class:`FrameValues` (hulls); ``names``
-    are the random values' unique names (:func:`.randoms.unique_names`)."""
+class _Hulls:
+    """Per matched frame, the hull of each unknown's intervals and the alternatives of each choice
+    (arrays over frames, filled group by group)."""
+
+    def __init__(self, n: int, names: dict[Any, str]):
+        self.n = n
+        self.names = names
+        self.bounds: dict[Term, tuple[np.ndarray, np.ndarray]] = {}
+        self.chosen: dict[Term, np.ndarray] = {}
+
+    def widen(self, u: Term, frames: np.ndarray, low: np.ndarray, high: np.ndarray) -> None:
+        lo, hi = self.bounds.setdefault(u, (np.full(self.n, np.inf), np.full(self.n, -np.inf)))
+        np.minimum.at(lo, frames, low)
+        np.maximum.at(hi, frames, high)
+
+    def choose(self, leaf: Term, frames: np.ndarray, alternatives: np.ndarray) -> None:
+        taken = self.chosen.setdefault(leaf, np.zeros((self.n, leaf.value.size), dtype=bool))
+        taken[frames, alternatives.astype(np.intp)] = True
+
+    def frames(self, counts: np.ndarray) -> list[FrameValues]:
+        found = [FrameValues(int(n)) for n in counts]
+        for u, (lo, hi) in self.bounds.items():
+            for k in np.flatnonzero(lo <= hi).tolist():
+                if u.op == "point":
+                    point, axis = u.value
+                    box = found[k].points.setdefault(self.names[point], [[], []])
+                    box[axis] = [float(lo[k]), float(hi[k])]
+                else:
+                    found[k].ranges[self.names[u.value]] = [float(lo[k]), float(hi[k])]
+        for leaf, taken in self.chosen.items():
+            for k in np.flatnonzero(taken.any(axis=1)).tolist():
+                found[k].options[self.names[leaf.value]] = (np.flatnonzero(taken[k]).tolist(), leaf.value.size)
+        return found
+
+
+def _group_values(ev: Evaluator, group: Group, tolerance: Tolerance, slot: np.ndarray, hulls: _Hulls) -> None:
+    """Put one group's values of every row into its frame's hulls (``slot``: each row's frame)."""
     choices = sorted((u for u in group.unknowns if u.op == "choice"), key=repr)
     for leaf in choices:
         ev.expand_choice(leaf)
     ev.unknowns = frozenset(u for u in group.unknowns if u.op != "choice")
-    feasible = _decide_expanded(ev, group, tolerance)
-    where = slot[ev.origin]
+    feasible = np.flatnonzero(_decide_expanded(ev, group, tolerance))
+    where = slot[ev.origin[feasible]]
     for leaf in choices:
-        chosen = ev.memo[leaf]
-        for row in np.flatnonzero(feasible).tolist():
-            entry = found[where[row]].options.setdefault(names[leaf.value], ([], leaf.value.size))[0]
-            if int(chosen[row]) not in entry:
-                entry.append(int(chosen[row]))
-                entry.sort()
+        hulls.choose(leaf, where, ev.memo[leaf][feasible])
     if not ev.unknowns:
         return
-    bounds = _intervals(ev, group, tolerance, feasible)
-    for u, (low, high) in bounds.items():
-        for row in np.flatnonzero(feasible).tolist():
-            _widen(found[where[row]], u, names, float(low[row]), float(high[row]))
+    for u, (low, high) in _intervals(ev, group, tolerance, feasible).items():
+        hulls.widen(u, where, low[feasible], high[feasible])
 
 
 def _intervals(
     ev: Evaluator, group: Group, tolerance: Tolerance, feasible: np.ndarray
 ) -> dict[Term, tuple[np.ndarray, np.ndarray]]:
-    """Per unknown, its interval in every feasible row: closed form, else bisection row by row."""
+    """Per unknown, its interval in the ``feasible`` rows (indices; arrays over all rows): closed
+    form, else bisection row by row."""
     closed = closed_form_intervals(ev, group, tolerance)
     if closed is not None:
         return closed
     unknowns = sorted(ev.unknowns, key=repr)
     found = {u: (np.full(ev.size, np.nan), np.full(ev.size, np.nan)) for u in unknowns}
-    for row in np.flatnonzero(feasible).tolist():
+    for row in feasible.tolist():
         problem = build(ev, group, tolerance, row)
         for u, (lo, hi) in _bisected(problem, ev.geometry, tolerance).items():
             found[u][0][row], found[u][1][row] = lo, hi
@@ -199,14 +218,3 @@ def _lowest(feasible, start: float, end: float, witness: float | None) -> float:
         else:
             low = middle
     return -math.inf if low <= -LIMIT else low
-
-
-def _widen(values: FrameValues, u: Term, names: dict[Any, str], low: float, high: float) -> None:
-    """Put [low, high] into the frame's hull of unknown ``u`` (a scalar or a point coordinate)."""
-    if u.op == "point":
-        point, axis = u.value
-        box = values.points.setdefault(names[point], [[math.inf, -math.inf], [math.inf, -math.inf]])
-        target = box[axis]
-    else:
-        target = values.ranges.setdefault(names[u.value], [math.inf, -math.inf])
-    target[0], target[1] = min(target[0], low), max(target[1], high)

@@ -23,6 +23,9 @@ from .sources import ResultsSource
 MOST_LISTED = 200
 """Matches listed per bin (the count says how many there are)."""
 
+MOST_SOURCES = 500
+"""Sources in the per-source table (the coverage table has them all)."""
+
 
 def write_coverage_page(
     source: ResultsSource, coverage: Coverage, path: str | Path, progress: Callable[[Iterable], Iterable] = iter
@@ -99,7 +102,7 @@ def _pairs(coverage: Coverage) -> list[str]:
 def _sources_table(coverage: Coverage) -> str:
     head = "".join(f"<th>{html.escape(axis.name)}</th>" for axis in coverage.axes)
     lines = []
-    for source in coverage.sources:
+    for source in coverage.sources[:MOST_SOURCES]:
         cells = "".join(
             f"<td>{int((coverage.counts(a, source) > 0).sum())} / {axis.bins}</td>"
             for a, axis in enumerate(coverage.axes)

@@ -271,3 +271,34 @@ def test_bad_options_are_user_errors(extra, message, capsys, tmp_path):
     code = main(["coverage", str(FIG3), str(FILES[0]), *extra])
     assert code == 2
     assert message in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------- recovered sets
+def _recovered(program: str, frame: dict, position: float = 1e-6):
+    from scenegrep.scene import SceneOptions, Tolerance
+    from tests.scene.frames import HEADER, MAP, trace_of
+
+    query = compile_scene(HEADER + program, "test.scenic")
+    result = query.match(trace_of(frame), MAP, SceneOptions(Tolerance(position, 1e-6)))
+    assert result.matched.tolist() == [True]
+    return result.recovered[0]
+
+
+PLACED = "ego = new Car at 0 @ 0, facing 0, with regionContainedIn everywhere\n"
+
+
+def test_an_options_value_is_the_set_of_alternatives_that_reproduce_the_frame():
+    program = PLACED + "other = new Car at 0 @ Uniform(5, 10, 15), facing 0, with regionContainedIn everywhere\n"
+    frame = {"ego": ("Car", 0.0, 0.0, 0.0), "car": ("Car", 0.0, 10.0, 0.0)}
+    (exact,) = _recovered(program, frame).options.values()
+    (loose,) = _recovered(program, frame, position=6.0).options.values()
+    assert exact == ([1], 3) and loose == ([0, 1, 2], 3)
+
+
+def test_several_correspondences_give_the_hull_of_their_values_and_are_counted():
+    program = PLACED + "other = new Car at 0 @ Range(5, 20), facing 0, with regionContainedIn everywhere\n"
+    frame = {"ego": ("Car", 0.0, 0.0, 0.0), "a": ("Car", 0.0, 8.0, 0.0), "b": ("Car", 0.0, 12.0, 0.0)}
+    found = _recovered(program, frame)
+    assert found.correspondences == 2
+    ((lo, hi),) = found.ranges.values()
+    assert lo == pytest.approx(8.0, abs=1e-5) and hi == pytest.approx(12.0, abs=1e-5)

@@ -81,11 +81,20 @@ RELATIONS = {
 }
 
 
+@pytest.fixture(scope="module", autouse=True)
+def map_cache(tmp_path_factory):
+    """A fresh cache of converted maps for this module's reads through ``readers.read_map``."""
+    folder = tmp_path_factory.mktemp("cache")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("SCENEGREP_CACHE", str(folder))
+        yield folder
+
+
 @pytest.fixture(scope="module")
 def hand_map(tmp_path_factory):
     path = tmp_path_factory.mktemp("l2") / "hand.osm"
     path.write_text(osm(NODES, WAYS, RELATIONS))
-    return lanelet2.read_map(path)
+    return lanelet2.convert(path)
 
 
 def test_lanes_run_along_their_aligned_bounds(hand_map):
@@ -126,7 +135,7 @@ def test_intersection_area_polygon_holds_the_lanes_naming_it(tmp_path):
     relations = RELATIONS | {101: lanelet(13, 14, subtype="road", intersection_area="50")}
     path = tmp_path / "area.osm"
     path.write_text(osm(NODES, ways, relations))
-    (area,) = lanelet2.read_map(path).intersections
+    (area,) = lanelet2.convert(path).intersections
     assert area.lanes == ("101",) and shapely.equals(area.polygon, shapely.box(10, 0, 20, 3))
 
 
@@ -146,7 +155,7 @@ def test_crosswalk_regulatory_elements_give_exact_polygons(tmp_path):
     }
     path = tmp_path / "crosswalks.osm"
     path.write_text(osm(nodes, ways, relations))
-    lanelet_crossing, own = lanelet2.read_map(path).crosswalks
+    lanelet_crossing, own = lanelet2.convert(path).crosswalks
     assert (
         shapely.equals(lanelet_crossing.polygon, shapely.box(22, -2, 24, 5)) and lanelet_crossing.centreline is not None
     )
@@ -163,9 +172,26 @@ def test_lat_lon_nodes_are_projected_to_metres(tmp_path):
     nodes = {1: (139.76, 35.68), 2: (139.76 + dlon, 35.68), 3: (139.76, 35.68 + dlat), 4: (139.76 + dlon, 35.68 + dlat)}
     path = tmp_path / "geo.osm"
     path.write_text(osm(nodes, {1: ([3, 4], LINE), 2: ([1, 2], LINE)}, {9: lanelet(1, 2)}, latlon=True))
-    (lane,) = lanelet2.read_map(path).lanes
+    (lane,) = lanelet2.convert(path).lanes
     length = shapely.LineString(lane.centreline).length
     assert length == pytest.approx(50, rel=1e-3) and lane.polygon.area / length == pytest.approx(3.5, rel=1e-3)
+
+
+def test_read_map_converts_once_per_content(map_cache, tmp_path, monkeypatch):
+    """The second read of the same content (under another name too) comes from the cache, equal
+    to the conversion and named after the file read."""
+    from scenegrep.readers.map_cache import cached_map_path
+
+    text = osm(NODES, WAYS, RELATIONS)
+    first, second = tmp_path / "first.osm", tmp_path / "second.osm"
+    first.write_text(text)
+    second.write_text(text)
+    converted = lanelet2.read_map(first)
+    cached = cached_map_path(first, f"lanelet2-v{lanelet2.CONVERSION_VERSION}")
+    assert cached.is_file() and cached.parent.parent == map_cache
+    monkeypatch.setattr(lanelet2, "convert", lambda path: pytest.fail("converted again"))
+    again = lanelet2.read_map(second)
+    assert again.equals(dataclasses.replace(converted, name="second")) and again.source == str(second)
 
 
 def test_stop_lines_travel_through_parquet_equality_and_cropping(hand_map, tmp_path):
@@ -204,7 +230,7 @@ def test_malformed_maps_are_one_line_errors_with_the_line(tmp_path, text, messag
     path = tmp_path / "bad.osm"
     path.write_text(text)
     with pytest.raises(UserError, match=r"bad\.osm" + ("" if message.startswith(":") else ".*") + message) as error:
-        lanelet2.read_map(path)
+        lanelet2.convert(path)
     assert "\n" not in error.value.one_line()
 
 

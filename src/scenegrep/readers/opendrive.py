@@ -34,22 +34,18 @@ the crossing layer of every OpenDRIVE map is empty.
 
 from __future__ import annotations
 
-import contextlib
 import warnings
 import xml.etree.ElementTree as ElementTree
-from dataclasses import replace
 from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..cache import cache_dir, file_digest
 from ..errors import UserError, at
 from ..model import Area, Lane, LaneNeighbour, RoadMap
-from ..writers.trace_parquet import write_map_parquet
+from . import map_cache
 from .common import reading, regular_file
-from .trace_parquet import read_map as read_cached
 
 FORMAT = "opendrive"
 UNKNOWN_LAYERS: frozenset[str] = frozenset()
@@ -170,21 +166,18 @@ def parse_network(path: Path) -> Any:
 
 def cached_map_path(path: Path) -> Path:
     """Where the converted map of an .xodr file is cached."""
-    return (
-        cache_dir() / "maps" / f"{file_digest(path)[:20]}-scenic{version('scenic')}-v{CONVERSION_VERSION}.map.parquet"
-    )
+    return map_cache.cached_map_path(path, _cache_tag())
+
+
+def _cache_tag() -> str:
+    """The cache tag of a conversion: the Scenic version and :data:`CONVERSION_VERSION`."""
+    return f"scenic{version('scenic')}-v{CONVERSION_VERSION}"
 
 
 def read_map(path: str | Path, key: str | None = None) -> RoadMap:
-    """Read an OpenDRIVE file (``key`` is unused: one map per file), through the cache.
-
-    The cache is best effort: when it cannot be written the map is still returned.
-    """
+    """Read an OpenDRIVE file (``key`` is unused: one map per file), through the cache
+    (:mod:`.map_cache`)."""
     path = checked_xodr(path)
-    cached = cached_map_path(path)
-    if cached.is_file():
-        return replace(read_cached(cached), source=str(path))
-    road_map = convert_network(parse_network(path), path.stem, str(path))
-    with contextlib.suppress(OSError, UserError):  # the writer's "cannot write" (read-only cache)
-        write_map_parquet(road_map, cached)
-    return road_map
+    return map_cache.through_cache(
+        path, _cache_tag(), lambda: convert_network(parse_network(path), path.stem, str(path))
+    )

@@ -215,6 +215,10 @@ MALFORMED = [
     (osm(NODES, WAYS, RELATIONS).replace("v='10'", "v='nan'", 1), r"local_x 'nan' is not a finite coordinate"),
     (osm(NODES, WAYS, RELATIONS).replace("v='10'", "v='1e300'", 1), r"local_x '1e300' is not a finite coordinate"),
     (osm({1: (0, 95), 2: (1, 95)}, {1: ([1, 2], LINE)}, {}, latlon=True), r"cannot project .* latitude outside"),
+    (
+        osm(NODES, WAYS, RELATIONS).replace("<tag k='local_x' v='10'/>", "", 1),
+        r":\d+: node \d+ has no local_x/local_y while other nodes have them",
+    ),
     (osm(NODES, WAYS, RELATIONS).replace("30 mph", "fast"), r"speed_limit 'fast' is not a speed"),
     (osm(NODES, WAYS, RELATIONS)[:2000], r":\d+:\d+: not well-formed XML"),
     ("<?xml version='1.0'?><!DOCTYPE osm [<!ENTITY a 'aaaa'>]><osm>&a;</osm>", r":1:\d+: DOCTYPE and ENTITY"),

@@ -136,8 +136,12 @@ class _Reader:
 
     def _coordinates(self) -> np.ndarray:
         nodes = self.doc.nodes.values()
-        if all("local_x" in n.tags and "local_y" in n.tags for n in nodes):
+        local = [("local_x" in n.tags and "local_y" in n.tags) for n in nodes]
+        if all(local):
             return np.column_stack([self._numbers("local_x", True), self._numbers("local_y", True)])
+        if any(local):  # Autoware may leave lat/lon as placeholders beside local_x/local_y
+            node_id, node = next((i, n) for (i, n), has in zip(self.doc.nodes.items(), local) if not has)
+            raise self.fail(node, f"node {node_id} has no local_x/local_y while other nodes have them")
         if not nodes:
             return np.zeros((0, 2))
         lat, lon = self._numbers("lat", False), self._numbers("lon", False)

@@ -1,12 +1,13 @@
-"""``scenegrep export RESULTS (--mcap OUT.mcap | --refav OUT --prompt TEXT | --openscenario DIR)``: a
-results table for other tools.
+"""``scenegrep export RESULTS (--mcap OUT.mcap | --refav OUT --prompt TEXT | --openscenario DIR |
+--scenic DIR)``: a results table for other tools.
 
 RESULTS is a results table (Parquet, JSON lines or CSV) or a run directory. ``--mcap`` writes
 its matches as Foxglove events; ``--refav`` writes a RefAV scenario-mining submission
 (:mod:`scenegrep.dataset.refav_export`): RefAV's own pickle when OUT ends in ``.pkl``, the same
 data as JSON (which ``scenegrep evaluate`` reads) when it ends in ``.json``; ``--openscenario``
-writes every match as an OpenSCENARIO 1.3 file in DIR (:mod:`scenegrep.dataset.openscenario_export`).
-Exit codes: 0 written, 2 user error.
+writes every match as an OpenSCENARIO 1.3 file in DIR (:mod:`scenegrep.dataset.openscenario_export`);
+``--scenic`` every match as a Scenic program that re-runs it (:mod:`scenegrep.dataset.scenic_export`).
+With either, ``--context R`` adds the labeled objects within R m. Exit codes: 0 written, 2 user error.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ from ..errors import UserError
 def add_parser(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "export",
-        help="write a results table for other tools (Foxglove MCAP events, RefAV submission)",
+        help="write a results table for other tools (Foxglove MCAP events, RefAV submission, OpenSCENARIO, Scenic)",
         description="Write the matches of a results table as Foxglove events (schema foxglove.Event, topic "
         "/scenegrep/matches) in an MCAP file: each event spans the window's first to last frame at the "
         "recording's absolute time, with the trace and the correspondence as metadata. Or, for results over "
@@ -36,11 +37,12 @@ def add_parser(subparsers: Any) -> None:
     target.add_argument(
         "--openscenario", metavar="DIR", help="the folder to write each match to as OpenSCENARIO (.xosc)"
     )
+    target.add_argument("--scenic", metavar="DIR", help="the folder to write each match to as a Scenic program")
     parser.add_argument(
         "--context",
         metavar="R",
         type=float,
-        help="--openscenario: also every labeled object within R m of a corresponded one (default: none)",
+        help="--openscenario, --scenic: also every labeled object within R m of a corresponded one (default: none)",
     )
     parser.add_argument("--prompt", metavar="TEXT", help="--refav: the RefAV prompt the query answers")
     parser.add_argument(
@@ -51,15 +53,17 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "--dataset",
         metavar="DATASET",
-        help="--refav, --openscenario: the dataset of the results (default: where they lie)",
+        help="--refav, --openscenario, --scenic: the dataset of the results (default: where they lie)",
     )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.context is not None and args.openscenario is None:
-        raise UserError("--context goes with --openscenario")
+    if args.context is not None and args.openscenario is None and args.scenic is None:
+        raise UserError("--context goes with --openscenario or --scenic")
+    if args.scenic is not None:
+        return _scenic(args)
     if args.refav is not None:
         return _refav(args)
     if args.openscenario is not None:
@@ -132,4 +136,25 @@ def _openscenario(args: argparse.Namespace) -> int:
                 "an initial pose, no trajectory",
                 file=sys.stderr,
             )
+    return 0
+
+
+def _scenic(args: argparse.Namespace) -> int:
+    from ..dataset.moments import moments
+    from ..dataset.scenic_export import write_scenic_programs
+    from ..view.sources import ResultsSource
+
+    if args.prompt is not None or args.referred is not None:
+        raise UserError("--prompt and --referred go with --refav")
+    source = ResultsSource.open(args.results, args.dataset)
+    found = moments(source.results, lambda trace_id: source.load(trace_id)[0], args.context)
+    written = write_scenic_programs(found, args.scenic)
+    if not args.quiet:
+        for reason in sorted({w.without_map for w in written if w.without_map}):
+            count = sum(w.without_map == reason for w in written)
+            print(
+                f"scenegrep: {count} programs without a road map ({reason}): objects placed without roads",
+                file=sys.stderr,
+            )
+        print(f"scenegrep: {len(written)} matches written as Scenic programs to {args.scenic}", file=sys.stderr)
     return 0

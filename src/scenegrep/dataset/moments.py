@@ -50,7 +50,9 @@ class ObjectPath:
 @dataclass(frozen=True, eq=False)
 class Moment:
     """One match (row ``match`` of trace ``trace_name``) as objects over its window of dataset
-    frames ``start_frame``..``end_frame`` (inclusive), starting ``start_time`` s into the trace;
+    frames ``start_frame``..``end_frame`` (inclusive), starting ``start_time`` s into the trace and
+    lasting ``duration`` s (first to last frame; 0 for one frame); ``frame_period`` is the trace's
+    frame period (s, the median step of its known frame times; 0.1 with fewer than two);
     ``map_source`` is where the trace's road map is read (None: the trace has none); ``ego`` is the
     ego's label id when the trace names one."""
 
@@ -60,6 +62,8 @@ class Moment:
     start_frame: int
     end_frame: int
     start_time: float
+    duration: float
+    frame_period: float
     map_source: MapSource | None
     ego: str | None
     objects: tuple[ObjectPath, ...]
@@ -67,8 +71,9 @@ class Moment:
 
 def moments(results: Results, load: Callable[[str], LabelTrace], context: float | None = None) -> Iterator[Moment]:
     """The moments of every match row of ``results`` in table order; ``load`` gives a trace by
-    trace id; ``context`` (m, 0..:data:`MAX_CONTEXT_M`) adds nearby labeled objects. UserError for
-    a table whose traces failed or whose rows name objects the trace does not have."""
+    trace id; ``context`` (m, 0..:data:`MAX_CONTEXT_M`) adds nearby labeled objects. Rows that are
+    not matches (failed, pruned, without a match) have no moment. UserError for a radius out of
+    range and for rows that do not fit their trace (see :func:`moment_of`)."""
     if context is not None and not 0 <= context <= MAX_CONTEXT_M:
         raise UserError(f"--context {context}: give a radius from 0 to {MAX_CONTEXT_M:g} m")
     rows = [r for r in results.table.to_pylist() if r["status"] == "match"]
@@ -80,9 +85,14 @@ def moments(results: Results, load: Callable[[str], LabelTrace], context: float 
 
 
 def moment_of(trace: LabelTrace, row: dict[str, Any], context: float | None = None) -> Moment:
-    """The moment of one match row over ``trace`` (see :func:`moments`)."""
+    """The moment of one match row over ``trace`` (see :func:`moments`). UserError for a
+    correspondence that is not scenegrep's JSON, an object the trace does not have or that is not
+    observed in the window, a window outside the trace or with frames of unknown time."""
     correspondence = _correspondence(row)
     positions = _window(trace, row)
+    times = trace.frame_time[positions]
+    if np.isnan(times).any():
+        raise UserError(f"match {row['match']} of {trace.name}: the trace gives no time for some frames of its window")
     ids = trace.objects.row_of()
     missing = sorted(set(correspondence.values()) - set(ids))
     if missing:
@@ -99,7 +109,9 @@ def moment_of(trace: LabelTrace, row: dict[str, Any], context: float | None = No
         match=int(row["match"]),
         start_frame=int(row["start_frame"]),
         end_frame=int(row["end_frame"]),
-        start_time=float(trace.frame_time[positions[0]]),
+        start_time=float(times[0]),
+        duration=float(times[-1] - times[0]),
+        frame_period=_frame_period(trace.frame_time),
         map_source=trace.map_source,
         ego=trace.ego if trace.ego in ids else None,
         objects=objects,
@@ -130,19 +142,18 @@ def _nearby(trace: LabelTrace, in_window: np.ndarray, anchors: list[int], radius
     """Label ids of the objects besides ``anchors`` whose centre comes within ``radius`` m of an
     anchor's centre in a frame of the window, sorted."""
     states = trace.states
-    frame, obj = states.frame[in_window], states.object[in_window]
-    xy = np.stack([states.x[in_window], states.y[in_window]], axis=1)
-    is_anchor = np.isin(obj, anchors)
-    near: set[int] = set()
-    for f in np.unique(frame[is_anchor]).tolist():
-        here = frame == f
-        centres = xy[here & is_anchor]
-        others = here & ~is_anchor
-        if not others.any():
-            continue
-        gaps = np.linalg.norm(xy[others][:, None, :] - centres[None, :, :], axis=2).min(axis=1)
-        near.update(obj[others][gaps <= radius].tolist())
-    return sorted(str(trace.objects.id[o]) for o in near)
+    rows = np.flatnonzero(in_window)
+    frame, obj = states.frame[rows], states.object[rows]
+    anchor_rows = np.flatnonzero(np.isin(obj, anchors))
+    # states are in (frame, object) order: each anchor observation's frame is one run of rows
+    start = np.searchsorted(frame, frame[anchor_rows], side="left")
+    stop = np.searchsorted(frame, frame[anchor_rows], side="right")
+    counts = stop - start
+    anchor = np.repeat(anchor_rows, counts)
+    other = np.repeat(start - np.cumsum(counts) + counts, counts) + np.arange(counts.sum())
+    gap = np.hypot(states.x[rows[other]] - states.x[rows[anchor]], states.y[rows[other]] - states.y[rows[anchor]])
+    near = np.unique(obj[other][(gap <= radius) & ~np.isin(obj[other], anchors)])
+    return sorted(str(trace.objects.id[o]) for o in near.tolist())
 
 
 def _path(trace: LabelTrace, in_window: np.ndarray, row: int, label: str, name: str | None, first: int) -> ObjectPath:
@@ -163,6 +174,12 @@ def _path(trace: LabelTrace, in_window: np.ndarray, row: int, label: str, name: 
         z=states.z[k].copy(),
         heading=states.heading[k].copy(),
     )
+
+
+def _frame_period(frame_time: np.ndarray) -> float:
+    """The median step (s) of the known (not NaN) frame times; 0.1 with fewer than two."""
+    steps = np.diff(frame_time[~np.isnan(frame_time)])
+    return float(np.median(steps)) if len(steps) else 0.1
 
 
 def _median(values: np.ndarray) -> float:

@@ -1,0 +1,274 @@
+"""Matches as concrete Scenic programs that re-run the labeled moment in Scenic's Newtonian simulator.
+
+:func:`scenic_program` writes one :class:`~.moments.Moment` as the text of a Scenic 3.1.1
+program: every object of the moment is a ``new`` object (the trace's ego, else the program's
+``ego``, else the first object, is Scenic's ``ego``) of the Scenic class of its category's
+canonical kind (:data:`SCENIC_CLASSES`), at its first labeled position and heading, with its
+labeled size (a size the labels do not give is left to the class's default), and with the
+behaviour ``FollowRecording``, which at every simulation step takes an action putting the
+object at its recorded pose for the end of the step: the labeled positions and headings as
+literals (``repr`` of each float, so the values are the labels' bit for bit), linear between
+observations (headings the short way round), held before the first and after the last. The
+Newtonian physics then moves nothing (every object's velocity stays 0), so a simulation with
+any timestep follows the recording up to rounding. ``terminate when`` ends it when the
+window's duration has passed (rounded to whole steps).
+
+The map: an OpenDRIVE map (a trace's ``map_source`` of format ``opendrive`` naming a file) is
+the program's ``param map = localPath(...)`` (relative to the program's folder) with the model
+``scenic.simulators.newtonian.driving_model``; Scenic reads no other map format, so such
+moments are written without roads (model ``scenic.simulators.newtonian.model``), which the
+program's header comment says (and :func:`write_scenic_programs` reports). Every object is
+written ``with allowCollisions True, with requireVisible False, with regionContainedIn
+everywhere``: labeled boxes overlap and leave the road, and Scenic's default requirements would
+reject such scenes. Positions are 2-D (Scenic's driving domain is 2-D: compile with ``--2d`` /
+``mode2D=True``); elevations are not written.
+
+Every text from the data (names, ids, categories, paths) enters a program as a Python string
+literal (``repr``) or, in comments, JSON-escaped on one line, so no value can inject code.
+Writing a program executes nothing.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import UserError, at
+from ..model.taxonomy import kind_of
+from .moments import Moment, ObjectPath
+
+SCENIC_VERSION = "3.1.1"
+"""The Scenic version the programs are written for (the pinned one)."""
+
+DRIVING_MODEL = "scenic.simulators.newtonian.driving_model"
+"""The model of programs on an OpenDRIVE map."""
+
+GENERIC_MODEL = "scenic.simulators.newtonian.model"
+"""The model of programs without a map Scenic can read (no roads)."""
+
+SCENIC_CLASSES: dict[str, tuple[str, str | None, str | None]] = {
+    "car": ("Car", None, ""),
+    "truck": ("Truck", "Car", "Car"),
+    "bus": ("Bus", "Car", "Car"),
+    "trailer": ("Trailer", "Car", "Car"),
+    "motorcycle": ("Motorcycle", "Car", "Car"),
+    "bicycle": ("Bicycle", "Car", "Car"),
+    "pedestrian": ("Pedestrian", None, ""),
+    "animal": ("Animal", "Pedestrian", "Pedestrian"),
+    "static": ("StaticObject", "NewtonianActor", ""),
+    "other": ("OtherObject", "NewtonianActor", ""),
+}
+"""Canonical kind -> (Scenic class, its base class in the driving model, in the generic model).
+A base of None: the model defines the class itself; "": the program defines it on ``Object``."""
+
+_RUNTIME = '''import bisect
+import math
+from scenic.core.simulators import Action
+
+def recordedPath(text):
+    """A recorded path: rows (time, x, y, heading) of floats, one per line of four numbers."""
+    return tuple(tuple(float(value) for value in line.split()) for line in text.splitlines() if line.strip())
+
+def recordedPose(path, times, time):
+    """The pose (x, y, heading) at `time` s of a recorded path (rows (time, x, y, heading), and
+    `times` its times): linear between rows (the heading the short way round), held before the
+    first row and after the last."""
+    i = bisect.bisect_right(times, time)
+    if i == 0 or i == len(path):
+        return path[max(i - 1, 0)][1:]
+    (t0, x0, y0, h0), (t1, x1, y1, h1) = path[i - 1], path[i]
+    a = (time - t0) / (t1 - t0)
+    turn = (h1 - h0 + math.pi) % math.tau - math.pi
+    return x0 + a * (x1 - x0), y0 + a * (y1 - y0), h0 + a * turn
+
+class SetRecordedPose(Action):
+    """Puts the agent at a pose (x, y, heading) for the next simulation step."""
+    def __init__(self, pose):
+        self.pose = pose
+    def applyTo(self, obj, sim):
+        x, y, heading = self.pose
+        obj.position = Vector(x, y)
+        obj.heading = heading
+
+behavior FollowRecording(path):
+    """At every step, the recorded pose for the end of the step."""
+    times = [row[0] for row in path]
+    while True:
+        end = (simulation().currentTime + 1) * simulation().timestep
+        take SetRecordedPose(recordedPose(path, times, end))
+'''
+
+
+@dataclass(frozen=True)
+class WrittenProgram:
+    """One program written: its file, the moment's trace and match, and the reason it has no
+    road map (None: it has the trace's OpenDRIVE map)."""
+
+    path: Path
+    trace_name: str
+    match: int
+    without_map: str | None
+
+
+def scenic_program(moment: Moment, map_reference: str | None, without_map: str | None = None) -> str:
+    """The Scenic program of ``moment`` (module docstring): on the OpenDRIVE map at
+    ``map_reference`` (a path relative to the program's folder), or without roads when it is None,
+    ``without_map`` saying why. UserError for a moment without objects."""
+    if not moment.objects:
+        raise UserError(f"match {moment.match} of {moment.trace_name} has no labeled object to export")
+    ego = _ego_index(moment)
+    objects = [moment.objects[ego]] + [o for i, o in enumerate(moment.objects) if i != ego]
+    kinds = [kind_of(o.category) for o in objects]
+    lines = _header(moment, map_reference, without_map)
+    lines += [_RUNTIME]
+    lines += _classes(kinds, map_reference is not None)
+    for number, (path, kind) in enumerate(zip(objects, kinds)):
+        lines += _object(path, f"obj{number}" if number else "ego", SCENIC_CLASSES[kind][0])
+    steps = round(moment.duration / moment.frame_period) if moment.frame_period > 0 else 0
+    lines += [
+        f"# The moment lasts {moment.duration:.6g} s ({steps} frame periods of {moment.frame_period:.6g} s): "
+        "the simulation ends then, at any timestep.",
+        f"terminate when simulation().currentTime >= round({_number(moment.duration)} / simulation().timestep)",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def write_scenic_programs(moments: Iterable[Moment], folder: str | Path) -> list[WrittenProgram]:
+    """Write every moment's program into ``folder`` (created if needed), each as
+    ``<trace name>-<match>.scenic`` with the name reduced to letters, digits, ``.``, ``_`` and
+    ``-`` (a name two traces share gets the trace id's digest too), written atomically."""
+    from ..writers.atomic import atomic_path
+
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise UserError("not a directory: --scenic writes one program per match into a directory", at(folder))
+    written: list[WrittenProgram] = []
+    owners: dict[str, str] = {}
+    for moment in moments:
+        stem = _file_stem(moment.trace_name)
+        if owners.setdefault(stem, moment.trace_id) != moment.trace_id:
+            stem = f"{stem}-{hashlib.sha256(moment.trace_id.encode()).hexdigest()[:10]}"
+        path = folder / f"{stem}-{moment.match}.scenic"
+        reference, reason = _map_reference(moment, folder)
+        text = scenic_program(moment, reference, reason)
+        with atomic_path(path) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+        written.append(WrittenProgram(path, moment.trace_name, moment.match, reason))
+    return written
+
+
+def _ego_index(moment: Moment) -> int:
+    """The object that is Scenic's ego: the trace's ego, else the program's ``ego``, else the first."""
+    for i, o in enumerate(moment.objects):
+        if moment.ego is not None and o.label_id == moment.ego:
+            return i
+    for i, o in enumerate(moment.objects):
+        if o.program_name == "ego":
+            return i
+    return 0
+
+
+def _map_reference(moment: Moment, folder: Path) -> tuple[str | None, str | None]:
+    """The moment's OpenDRIVE map as a path relative to ``folder`` (None when it has none Scenic
+    reads), and why it has none."""
+    source = moment.map_source
+    if source is None:
+        return None, "the trace has no road map"
+    if source.format != "opendrive":
+        return None, f"Scenic reads no {source.format} map, only OpenDRIVE"
+    if not Path(source.path).is_file():
+        return None, f"its OpenDRIVE map {source.path} is not a file"
+    return os.path.relpath(os.path.abspath(source.path), os.path.abspath(folder)), None
+
+
+def _file_stem(name: str) -> str:
+    """A trace name as a file name part: letters, digits, ``.``, ``_``, ``-``; no leading dot."""
+    stem = re.sub(r"[^A-Za-z0-9._-]", "_", name).lstrip(".")[:100]
+    return stem or "trace"
+
+
+def _header(moment: Moment, map_reference: str | None, without_map: str | None) -> list[str]:
+    last = moment.start_time + moment.duration
+    lines = [
+        f"# scenegrep export: match {moment.match} of trace {_quoted(moment.trace_name)} "
+        f"(trace id {_quoted(moment.trace_id)}), frames {moment.start_frame}-{moment.end_frame}, "
+        f"{moment.start_time:.6g}-{last:.6g} s into the recording.",
+        f"# Scenic {SCENIC_VERSION}, 2-D mode (scenic --2d -S FILE; mode2D=True in Python): each object starts at its",
+        "# labeled pose and follows its recorded path (positions in the map frame, m; headings in rad,",
+        "# 0 along +y, counter-clockwise), linear between frames; elevations are not exported.",
+        "# Objects move by taking their pose at every step: their speeds in the simulation stay 0.",
+    ]
+    if map_reference is None:
+        lines += [
+            f"# No road map: {_quoted(without_map or '')[1:-1]}; the objects are placed without roads.",
+            f"model {GENERIC_MODEL}",
+        ]
+    else:
+        lines += [f"param map = localPath({map_reference!r})", f"model {DRIVING_MODEL}"]
+    return lines + [""]
+
+
+def _classes(kinds: list[str], driving: bool) -> list[str]:
+    """Definitions (bases first) of the Scenic classes the program uses that its model does not
+    define, and of the bases among them the program defines."""
+    bases = {name: (in_driving if driving else in_generic) for name, in_driving, in_generic in SCENIC_CLASSES.values()}
+    needed = {SCENIC_CLASSES[k][0] for k in kinds}
+    needed |= {bases[n] for n in needed if bases.get(bases[n] or "") is not None}
+    lines = []
+    for name, base in bases.items():
+        if name in needed and base is not None:
+            lines += [f"class {name}({base}):" if base else f"class {name}:", "    pass", ""]
+    return lines
+
+
+def _object(path: ObjectPath, name: str, cls: str) -> list[str]:
+    """The object's path literal and its ``new`` statement."""
+    constant = f"{name.upper()}_PATH"
+    role = "a context object" if path.program_name is None else f"program object {_quoted(path.program_name)}"
+    specifiers = [f"at {_number(path.x[0])} @ {_number(path.y[0])}", f"facing {_number(path.heading[0])}"]
+    unknown = []
+    for prop in ("width", "length", "height"):
+        value = getattr(path, prop)
+        if math.isfinite(value):
+            specifiers.append(f"with {prop} {_number(value)}")
+        else:
+            unknown.append(prop)
+    specifiers += [
+        f"with name {path.label_id!r}",
+        "with allowCollisions True",
+        "with requireVisible False",
+        "with regionContainedIn everywhere",
+        f"with behavior FollowRecording({constant})",
+    ]
+    lines = [f"# {name}: {role}, labeled object {_quoted(path.label_id)} ({_quoted(path.category)})"]
+    if unknown:
+        lines.append(f"# its labels give no {', '.join(unknown)}: Scenic's default for {cls}")
+    rows = np.stack([path.times, path.x, path.y, path.heading], axis=1).tolist()
+    lines += [
+        "# its path: time (s from the window's first frame), x (m), y (m), heading (rad)",
+        f'{constant} = recordedPath("""',
+        *(f"    {' '.join(_number(v) for v in row)}" for row in rows),
+        '""")',
+        f"{name} = new {cls} {', '.join(specifiers)}",
+        "",
+    ]
+    return lines
+
+
+def _number(value: float) -> str:
+    """A finite float as its exact Python literal."""
+    return repr(float(value))
+
+
+def _quoted(text: str) -> str:
+    """Text for a comment: JSON-quoted, non-ASCII and control characters escaped (one line)."""
+    return json.dumps(str(text), ensure_ascii=True)

@@ -60,7 +60,7 @@ def path_of(label: str, category: str, rows: list[tuple[float, float, float, flo
 
 
 def moment(objects, map_source=None, name="street", duration=0.2, trace_id="t1", match=0) -> Moment:
-    return Moment(trace_id, name, match, 10, 12, 1.0, duration, 0.1, map_source, None, tuple(objects))
+    return Moment(trace_id, name, match, 10, 12, 1.0, map_source, None, tuple(objects), duration, 0.1)
 
 
 EVERY_KIND = [

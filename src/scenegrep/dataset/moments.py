@@ -62,11 +62,11 @@ class Moment:
     start_frame: int
     end_frame: int
     start_time: float
-    duration: float
-    frame_period: float
     map_source: MapSource | None
     ego: str | None
     objects: tuple[ObjectPath, ...]
+    duration: float = 0.0
+    frame_period: float = 0.1
 
 
 def moments(results: Results, load: Callable[[str], LabelTrace], context: float | None = None) -> Iterator[Moment]:

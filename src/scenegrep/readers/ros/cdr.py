@@ -45,6 +45,9 @@ _DTYPES = {
 HEADER = 4
 """Bytes of the encapsulation header before a CDR payload."""
 
+ALIGN = 8
+"""The largest CDR alignment: payload origins in a batch's buffer are multiples of it."""
+
 
 class CdrError(ValueError):
     """A message that cannot be decoded: ``message`` is its position in the batch."""
@@ -70,12 +73,18 @@ class Payloads:
         CDR encapsulation header."""
         lengths = np.fromiter((len(p) for p in payloads), dtype=np.int64, count=len(payloads))
         for i, payload in enumerate(payloads):
-            if len(payload) < HEADER or payload[0] != 0 or payload[1] not in (1, 3):
+            if len(payload) < HEADER or payload[0] != 0 or payload[1] != 1:
                 kind = "big-endian CDR (not supported)" if payload[:2] in (b"\0\0", b"\0\2") else "not CDR"
                 raise CdrError(i, f"{kind}: encapsulation header {bytes(payload[:HEADER]).hex() or 'missing'}")
-        ends = np.cumsum(lengths)
-        buffer = np.frombuffer(b"".join(payloads), dtype=np.uint8)
-        return cls(buffer, ends - lengths + HEADER, lengths - HEADER)
+        # each payload placed so that its CDR origin is 8-aligned: an aligned field is then
+        # aligned in the buffer too, and a column is one gather from a typed view of it
+        slots = (lengths + (ALIGN - 1 + ALIGN - HEADER)) // ALIGN * ALIGN
+        ends = np.cumsum(slots)
+        buffer = np.zeros(int(ends[-1]) if len(ends) else 0, dtype=np.uint8)
+        first = ends - slots + (ALIGN - HEADER)
+        for offset, payload in zip(first.tolist(), payloads):
+            buffer[offset : offset + len(payload)] = np.frombuffer(payload, dtype=np.uint8)
+        return cls(buffer, first + HEADER, lengths - HEADER)
 
 
 @dataclass
@@ -121,13 +130,15 @@ class _Walker:
     def __init__(self, types: dict[str, tuple[Field, ...]], wanted: frozenset[str], data: Payloads):
         self.types = types
         self.wanted = wanted
+        self._prefixes = {w.rsplit(".", k)[0] for w in wanted for k in range(w.count(".") + 1)}
         self.data = data
         self.levels: dict[str, _Collect] = {}
         self._plain: dict[str, tuple[int, int] | None] = {}
+        self._views: dict[str, np.ndarray] = {}
 
     # ------------------------------------------------------------------ helpers
     def _want(self, path: str) -> bool:
-        return path in self.wanted or any(w.startswith(path + ".") for w in self.wanted)
+        return path in self._prefixes
 
     def _check(self, owner: np.ndarray, end: np.ndarray, what: str) -> None:
         bad = end > self.data.size[owner]
@@ -139,11 +150,13 @@ class _Walker:
 
     def _read(self, dtype: str, count: int, owner: np.ndarray, pos: np.ndarray, what: str) -> np.ndarray:
         """``count`` values of ``dtype`` at ``pos`` (aligned already) of each item: shape (n,) or (n, count)."""
-        width = np.dtype(dtype).itemsize * count
-        self._check(owner, pos + width, what)
-        at = (self.data.start[owner] + pos)[:, None] + np.arange(width)
-        values = self.data.buffer[at].view(dtype)
-        return values[:, 0] if count == 1 else values
+        size = np.dtype(dtype).itemsize
+        self._check(owner, pos + size * count, what)
+        view = self._views.get(dtype)
+        if view is None:
+            view = self._views[dtype] = self.data.buffer[: len(self.data.buffer) // size * size].view(dtype)
+        at = (self.data.start[owner] + pos) // size
+        return view[at] if count == 1 else view[at[:, None] + np.arange(count)]
 
     def _count(self, owner: np.ndarray, pos: np.ndarray, what: str, least: int) -> tuple[np.ndarray, np.ndarray]:
         """The uint32 count at ``pos`` (aligned here) and the position after it; a count whose

@@ -36,6 +36,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+import pyarrow as pa
 
 from ...errors import UserError
 from ...model import LabelTrace, ObjectTable, StateTable, TraceSource
@@ -325,18 +326,20 @@ class FrameBuilder:
         frame_all = np.concatenate(frame).astype(np.int64) if frame else np.empty(0, np.int64)
         by_frame = np.argsort(frame_all, kind="stable")
         frame_all = frame_all[by_frame]
-        ids_all = (np.concatenate(ids) if ids else np.empty(0, dtype=object))[by_frame].astype(str)
+        ids_all = (np.concatenate(ids) if ids else np.empty(0, dtype=object))[by_frame]
         values = (np.concatenate(columns) if columns else np.empty((0, 9)))[by_frame]
         category_all = (np.concatenate(categories) if categories else np.empty(0, dtype=object))[by_frame]
         # objects in the order they first appear (so chunks concatenate to the same table)
-        unique, first, inverse = np.unique(ids_all, return_index=True, return_inverse=True)
-        appearance = np.argsort(first, kind="stable")
-        code = np.empty(len(unique), dtype=np.int64)
-        code[appearance] = np.arange(len(unique))
-        inverse = code[inverse]
-        names, category = unique[appearance], category_all[first[appearance]]
+        encoded = pa.array(ids_all, type=pa.string()).dictionary_encode()
+        inverse = encoded.indices.to_numpy(zero_copy_only=False).astype(np.int64)
+        names = np.asarray(encoded.dictionary.to_pylist(), dtype=object)
+        # codes are numbered in order of first appearance: a code is new where it passes every earlier one
+        seen = np.maximum.accumulate(inverse) if len(inverse) else inverse
+        first = np.flatnonzero(np.r_[len(inverse) > 0, inverse[1:] > seen[:-1]])
+        category = category_all[first]
         key = frame_all * max(len(names), 1) + inverse
-        _, unique_rows = np.unique(key, return_index=True)
+        order = np.argsort(key, kind="stable")
+        unique_rows = order[np.r_[True, key[order][1:] != key[order][:-1]]] if len(key) else order
         x, y, z, heading, length, width, height, vx, vy = values[unique_rows].T
         states = StateTable.build(
             frame_all[unique_rows],

@@ -21,7 +21,7 @@ from .options import BagOptions, current
 
 FORMAT = "ros-bag"
 
-BATCH = 4096
+BATCH = 1024
 """Messages decoded together by the offline reader."""
 
 

@@ -89,6 +89,9 @@ KIND_LABEL = {
 
 TRACKED_TOPIC = "/perception/object_recognition/tracking/objects"
 
+ORIGIN_NS = 1_700_000_000_000_000_000
+"""The header stamp a test writes for a trace's first frame (2023-11-14)."""
+
 
 def _uses(name: str) -> list[str]:
     package = name.split("/")[0]
@@ -193,7 +196,7 @@ def tracked_object(object_id: str, kind: str, pose: dict, yaw: float, row: dict)
 def write_tracked(
     trace: LabelTrace,
     path: Path,
-    origin_ns: int = 1_700_000_000_000_000_000,
+    origin_ns: int = ORIGIN_NS,
     drop: frozenset[int] = frozenset(),
     late_tf: bool = False,
 ) -> None:

@@ -20,19 +20,15 @@ from scenegrep.readers.ros.options import BagOptions
 from scenegrep.readers.ros.reader import read_trace
 
 from .ros_writer import TRACKED_TOPIC as TOPIC
-from .ros_writer import BagWriter, frame_stamps, read_back_id, write_tracked
+from .ros_writer import ORIGIN_NS, BagWriter, frame_stamps, read_back_id, write_tracked
 
-AV2 = "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
 NUSCENES = "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl"
-ORIGIN = 1_700_000_000_000_000_000
+ORIGIN = ORIGIN_NS
 
 
 @pytest.fixture(scope="module")
-def av2(real_data, tmp_path_factory) -> tuple[LabelTrace, Path]:
-    trace = readers.read_trace(real_data / AV2)
-    path = tmp_path_factory.mktemp("bags") / "av2.mcap"
-    write_tracked(trace, path, ORIGIN)
-    return trace, path
+def av2(av2_bag) -> tuple[LabelTrace, Path]:
+    return av2_bag
 
 
 @pytest.fixture(scope="module")

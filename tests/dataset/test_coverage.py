@@ -302,3 +302,19 @@ def test_several_correspondences_give_the_hull_of_their_values_and_are_counted()
     assert found.correspondences == 2
     ((lo, hi),) = found.ranges.values()
     assert lo == pytest.approx(8.0, abs=1e-5) and hi == pytest.approx(12.0, abs=1e-5)
+
+
+def test_witness_values_name_each_default_position_apart():
+    from scenegrep import readers
+    from scenegrep.scene import SceneOptions
+
+    query = compile_scene("model scenic.domains.driving.model\nego = new Car\nother = new Car\n", "two.scenic")
+    trace = readers.read_trace(FILES[0])
+    result = query.match(trace, options=SceneOptions())
+    (frame,) = result.frames().tolist()
+    values = result.values(frame)
+    name = "point on: on road (default Vehicle.position)"
+    ids = trace.objects.id.tolist()
+    for key, label in ((name, "ego"), (name + " #2", result.correspondence(frame)["other"])):
+        at = (trace.states.object == ids.index(label)) & (trace.states.frame == frame)
+        assert values[key] == pytest.approx([trace.states.x[at][0], trace.states.y[at][0]], abs=1e-5)

@@ -20,6 +20,7 @@ from .evaluate import Evaluator, Labels, Rows
 from .geometry import MapGeometry
 from .match import TraceMatches
 from .program import SceneProgram
+from .randoms import unique_names
 from .solvers import solve
 from .solvers.problem import build
 
@@ -33,19 +34,22 @@ def witness_values(
     survivor: int,
 ) -> dict[str, Any]:
     """The random values of one matched frame (``survivor`` indexes ``matches.survivors``):
-    name -> number, [x, y] for a random point, or ``"option k of n"``; None where the
+    name (unique: :func:`.randoms.unique_names`) -> number, [x, y] for a random point, or
+    ``"option k of n"``; None where the
     solver proved feasibility without producing a value (a δ-sat box)."""
     rows = matches.survivors.take(np.array([survivor]))
     objects = {o.name: o for o in program.objects}
+    names = unique_names(matches.groups)
     values: dict[str, Any] = {}
     for group in matches.groups:
         if group.unknowns:
             ev = Evaluator(rows, labels, objects, geometry, position_tolerance=tolerance.position)
-            values.update(_group_witness(ev, group, tolerance))
+            values.update(_group_witness(ev, group, tolerance, names))
     return values
 
 
-def _group_witness(ev: Evaluator, group: Group, tolerance: Tolerance) -> dict[str, Any]:
+def _group_witness(ev: Evaluator, group: Group, tolerance: Tolerance, names: dict[Any, str]) -> dict[str, Any]:
+    """One group's values, named by ``names`` (:func:`.randoms.unique_names`)."""
     choices = sorted((u for u in group.unknowns if u.op == "choice"), key=repr)
     for leaf in choices:
         ev.expand_choice(leaf)
@@ -55,7 +59,7 @@ def _group_witness(ev: Evaluator, group: Group, tolerance: Tolerance) -> dict[st
         return {}
     row = int(feasible[0])
     found: dict[str, Any] = {
-        leaf.value.name: f"option {int(ev.memo[leaf][row]) + 1} of {leaf.value.size}" for leaf in choices
+        names[leaf.value]: f"option {int(ev.memo[leaf][row]) + 1} of {leaf.value.size}" for leaf in choices
     }
     if not ev.unknowns:
         return found
@@ -67,9 +71,9 @@ def _group_witness(ev: Evaluator, group: Group, tolerance: Tolerance) -> dict[st
         value = assignment.get(leaf)
         value = None if value is None else float(value)
         if leaf.op == "point":
-            points.setdefault(leaf.value[0].name, [None, None])[leaf.value[1]] = value
+            points.setdefault(names[leaf.value[0]], [None, None])[leaf.value[1]] = value
         else:
-            found[leaf.value.name] = value
+            found[names[leaf.value]] = value
     found.update(points)
     return found
 

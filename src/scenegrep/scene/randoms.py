@@ -5,7 +5,9 @@ A program's random values are its continuous variables (``Range``, ``Normal``,
 ``Uniform``, ``Discrete``, ``DiscreteRange``) and its random points (``new Point in R``,
 default positions ...). Their labels are not unique (the default position of every object of
 one class has the same label), so each gets the label followed by `` #2``, `` #3`` ... when an
-earlier one (in the order label, line, column) has the same label.
+earlier one has the same label: earlier in the groups' (dependency) order, which puts each
+object's default position in its own group, in creation order; within a group in the order
+label, line, column.
 """
 
 from __future__ import annotations
@@ -47,10 +49,13 @@ def _order(key: Any) -> tuple:
 def unique_names(groups: Iterable[Group]) -> dict[Any, str]:
     """Unique display names of the random values (keyed by their RandomVariable, FiniteChoice or
     RandomPoint) of the groups' unknowns; see the module docstring."""
-    keys = {_key(leaf) for group in groups for leaf in group.unknowns}
+    keys: dict[Any, None] = {}
+    for group in groups:
+        for leaf in sorted(group.unknowns, key=lambda leaf: (_order(_key(leaf)), repr(leaf))):
+            keys.setdefault(_key(leaf), None)
     seen: Counter[str] = Counter()
     names = {}
-    for key in sorted(keys, key=_order):
+    for key in keys:
         seen[key.name] += 1
         names[key] = key.name if seen[key.name] == 1 else f"{key.name} #{seen[key.name]}"
     return names

@@ -226,7 +226,6 @@ require (distance from ego to other) < 50
 """
 
 
-@pytest.mark.slow
 def test_scenario_coverage_is_that_of_the_initial_scenes(tmp_path):
     from scenegrep import readers
     from scenegrep.dataset import QuerySpec

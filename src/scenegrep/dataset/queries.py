@@ -311,13 +311,17 @@ def scenario_rows(result: Any, find_all: bool, explain: bool, intervals: bool = 
     each window's initial scene."""
     trace = result.trace
     rows = []
+    scenes: dict[int, dict[int, Any]] = {}
     for number, (match, first, last) in enumerate(result.windows()):
         row = _window(trace, number, first, last, match.correspondence)
         if explain:
             row["explanation"] = "\n".join(result.explain(result.matches.index(match), first))
         if intervals:
-            scene = result.initial_scene(result.matches.index(match), first)
-            row["intervals"] = json.dumps(scene.recovered[0].to_json(), allow_nan=True)
+            index = result.matches.index(match)
+            if index not in scenes:
+                scene = result.initial_scene(index)
+                scenes[index] = dict(zip(scene.frames().tolist(), scene.recovered))
+            row["intervals"] = json.dumps(scenes[index][first].to_json(), allow_nan=True)
         rows.append(row)
         if not find_all:
             break

@@ -84,11 +84,11 @@ class ScenarioResult:
         found = self.matches[match]
         return self.explainer.witness(found.correspondence, int(found.starts[0] if start is None else start))
 
-    def initial_scene(self, match: int, start: int) -> SceneResult:
-        """The initial scene of match number ``match`` checked at frame position ``start`` with the
-        match's correspondence (the scene engine's check that admitted the window)."""
+    def initial_scene(self, match: int) -> SceneResult:
+        """The initial scene of match number ``match`` checked at each of its window starts with its
+        correspondence (the scene engine's check that admitted its windows)."""
         found = self.matches[match]
-        return self.explainer.scene_at(found.correspondence, np.array([start]))
+        return self.explainer.scene_at(found.correspondence, np.asarray(found.starts))
 
     def why_not(self) -> str:
         """For a trace without a match: the furthest frame reached and what failed there."""

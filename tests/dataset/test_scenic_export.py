@@ -304,20 +304,35 @@ def check_round_trip(program: Path, row: dict, context: float | None, compile_fi
     return error
 
 
+def export_dataset_run(tmp_path: Path, query: list, data: list, context: float, capsys) -> list[Path]:
+    """Ingest ``data``, run a query (kind, program, options) over the dataset, export the run
+    directory: the programs and their rows."""
+    dataset = tmp_path / "dataset"
+    assert run(["ingest", *data, "--into", dataset, "-q"], capsys)[0] == 0
+    code, err = run([*query, "--dataset", dataset, "-j", "1", "-q"], capsys)
+    assert code == 0, err
+    (run_dir,) = (dataset / "runs").iterdir()
+    folder = tmp_path / "programs"
+    assert run(["export", run_dir, "--scenic", folder, "--context", context], capsys)[0] == 0
+    rows = [r for r in pq.read_table(run_dir / "results.parquet").to_pylist() if r["status"] == "match"]
+    return [(folder / f"{r['name']}-{r['match']}.scenic", r) for r in rows]
+
+
 @pytest.mark.slow
 def test_round_trip_on_the_sample_dataset(tmp_path, scenic_compiler, capsys):
-    """20 matches on Town01: 8 of a scene (a car following the ego's road), 6 of the left turn
-    and 6 of the pedestrian scenario (with context)."""
+    """20 matches on Town01: 8 of a scene (a car following the ego's road) and 6 of the left turn
+    over files, 6 of the pedestrian scenario over an ingested dataset (with context)."""
     left, walk = (
         [str(SAMPLE / f"{p}-00{i}.parquet") for i in range(6)]
         for p in ("s2_unprotected_left_turn", "s3_pass_pedestrian")
     )
     scene = ["scene", REPO / "examples/ground_truth/following.scenic", "--tolerance-position", "2",
              "--tolerance-heading", "0.5"]  # fmt: skip
+    turn = ["scenario", REPO / "examples/queries/s2_unprotected_left_turn.scenic", "--window", "20"]
+    passing = ["scenario", REPO / "examples/queries/s3_pass_pedestrian.scenic", "--window", "20"]
     programs = [(p, r, None) for p, r in export(tmp_path / "scene", scene, left[3:4], 8, None, capsys)]
-    for name, traces in (("s2_unprotected_left_turn", left), ("s3_pass_pedestrian", walk)):
-        query = ["scenario", REPO / f"examples/queries/{name}.scenic", "--window", "20"]
-        programs += [(p, r, 30.0) for p, r in export(tmp_path / name, query, traces, 6, 30.0, capsys)]
+    programs += [(p, r, 30.0) for p, r in export(tmp_path / "turn", turn, left, 6, 30.0, capsys)]
+    programs += [(p, r, 30.0) for p, r in export_dataset_run(tmp_path / "walk", passing, walk, 30.0, capsys)]
     assert len(programs) == 20
     errors = [check_round_trip(p, row, context, scenic_compiler) for p, row, context in programs]
     print(f"sample: {len(errors)} programs, largest position error {max(errors):.3g} m")

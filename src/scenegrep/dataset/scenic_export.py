@@ -109,12 +109,10 @@ behavior FollowRecording(path):
 
 @dataclass(frozen=True)
 class WrittenProgram:
-    """One program written: its file, the moment's trace and match, and the reason it has no
-    road map (None: it has the trace's OpenDRIVE map)."""
+    """One program written: its file and the reason it has no road map (None: it has the trace's
+    OpenDRIVE map)."""
 
     path: Path
-    trace_name: str
-    match: int
     without_map: str | None
 
 
@@ -162,7 +160,7 @@ def write_scenic_programs(moments: Iterable[Moment], folder: str | Path) -> list
         text = scenic_program(moment, reference, reason)
         with atomic_path(path) as tmp:
             tmp.write_text(text, encoding="utf-8")
-        written.append(WrittenProgram(path, moment.trace_name, moment.match, reason))
+        written.append(WrittenProgram(path, reason))
     return written
 
 

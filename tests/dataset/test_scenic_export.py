@@ -179,6 +179,8 @@ def test_hostile_names_and_paths_stay_literals_and_files_stay_in_the_folder(tmp_
     assert (
         written[0].without_map.startswith("its OpenDRIVE map") and written[2].without_map == "the trace has no road map"
     )
+    (odd,) = write_scenic_programs([moment(objects, MapSource("m", "x\n\u2028y"), trace_id="d")], tmp_path / "odd")
+    assert all("\n" not in w.without_map and "\u2028" not in w.without_map for w in [*written[:2], odd])
     scene = scene_of(scenic_compiler(files[0]))
     assert [o.name for o in scene.objects] == [evil, "\\n'), ego = ("]
     assert scene.objects[0].length == 1  # the labels give no length: Scenic's default

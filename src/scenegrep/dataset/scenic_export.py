@@ -182,9 +182,9 @@ def _map_reference(moment: Moment, folder: Path) -> tuple[str | None, str | None
     if source is None:
         return None, "the trace has no road map"
     if source.format != "opendrive":
-        return None, f"Scenic reads no {source.format} map, only OpenDRIVE"
+        return None, f"Scenic reads no {_shown(source.format)} map, only OpenDRIVE"
     if not Path(source.path).is_file():
-        return None, f"its OpenDRIVE map {source.path} is not a file"
+        return None, f"its OpenDRIVE map {_shown(source.path)} is not a file"
     return os.path.relpath(os.path.abspath(source.path), os.path.abspath(folder)), None
 
 
@@ -265,6 +265,11 @@ def _object(path: ObjectPath, name: str, cls: str) -> list[str]:
 def _number(value: float) -> str:
     """A finite float as its exact Python literal."""
     return repr(float(value))
+
+
+def _shown(text: str) -> str:
+    """A format name or path for a message: as it is when plain, else JSON-quoted (one line)."""
+    return text if re.fullmatch(r"[A-Za-z0-9._+/-]+", text) else _quoted(text)
 
 
 def _quoted(text: str) -> str:

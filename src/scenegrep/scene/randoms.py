@@ -62,11 +62,16 @@ def unique_names(groups: Iterable[Group]) -> dict[Any, str]:
 
 
 def declared(groups: list[Group]) -> list[Declared]:
-    """The declared random values of the groups' unknowns, in the order of :func:`unique_names`."""
+    """The declared random values of the groups' unknowns: variables and choices in the program's
+    order (line, column), then random points (map coordinates, the least telling) in the order of
+    :func:`unique_names`."""
     names = unique_names(groups)
     leaves = {_key(leaf): leaf for group in groups for leaf in group.unknowns}
     found = []
-    for key, name in names.items():
+    points = [key for key in names if leaves[key].op == "point"]
+    scalars = sorted((key for key in names if leaves[key].op != "point"), key=lambda key: _order(key)[1:])
+    for key in scalars + points:
+        name = names[key]
         leaf = leaves[key]
         line = getattr(getattr(key, "span", None), "line", 0)
         if leaf.op == "var":

@@ -18,6 +18,7 @@ import json
 import math
 import re
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -199,6 +200,19 @@ def test_programs_on_an_opendrive_map_name_it_relative_to_their_folder(tmp_path)
         assert "model scenic.simulators.newtonian.model" in no_map.path.read_text()
 
 
+@pytest.mark.parametrize(
+    "programs, trace_ego, expected",
+    [(("ego", None), "b", "a"), ((None, None), "b", "b"), ((None, "car"), None, "a"), (("car", "ego"), "a", "b")],
+)
+def test_scenics_ego_is_the_programs_ego_else_the_traces_else_the_first(programs, trace_ego, expected):
+    objects = [
+        replace(path_of(label, "car", [(0.0, 0.0, 0.0, 0.0)]), program_name=name) for label, name in zip("ab", programs)
+    ]
+    text = scenic_program(replace(moment(objects), ego=trace_ego), None)
+    assert re.search(r"^ego = new Car .*with name '(\w)'", text, re.MULTILINE).group(1) == expected
+    assert len(re.findall(r"^\w+ = new ", text, re.MULTILINE)) == 2
+
+
 def test_a_moment_without_objects_is_a_user_error(tmp_path):
     with pytest.raises(UserError, match="no labeled object"):
         write_scenic_programs([moment([])], tmp_path)
@@ -278,7 +292,7 @@ def check_round_trip(program: Path, row: dict, context: float | None, compile_fi
                     expected.add(ids[s.object[i]])
     scene = scene_of(compile_file(program))
     assert sorted(o.name for o in scene.objects) == sorted(expected)
-    assert scene.egoObject.name == (trace.ego or "ego")
+    assert scene.egoObject.name == json.loads(row["correspondence"]).get("ego", trace.ego)
     period = float(np.median(np.diff(trace.frame_time)))
     for obj in scene.objects:
         k = np.flatnonzero(in_window & (s.object == ids.index(obj.name)))

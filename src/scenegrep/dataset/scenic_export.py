@@ -1,8 +1,8 @@
 """Matches as concrete Scenic programs that re-run the labeled moment in Scenic's Newtonian simulator.
 
 :func:`scenic_program` writes one :class:`~.moments.Moment` as the text of a Scenic 3.1.1
-program: every object of the moment is a ``new`` object (the trace's ego, else the program's
-``ego``, else the first object, is Scenic's ``ego``) of the Scenic class of its category's
+program: every object of the moment is a ``new`` object (the one the query program's ``ego``
+corresponds to, else the trace's ego, else the first, is Scenic's ``ego``) of the Scenic class of its category's
 canonical kind (:data:`SCENIC_CLASSES`), at its first labeled position and heading, with its
 labeled size (a size the labels do not give is left to the class's default), and with the
 behaviour ``FollowRecording``, which at every simulation step takes an action putting the
@@ -165,12 +165,12 @@ def write_scenic_programs(moments: Iterable[Moment], folder: str | Path) -> list
 
 
 def _ego_index(moment: Moment) -> int:
-    """The object that is Scenic's ego: the trace's ego, else the program's ``ego``, else the first."""
-    for i, o in enumerate(moment.objects):
-        if moment.ego is not None and o.label_id == moment.ego:
-            return i
+    """The object that is Scenic's ego: the program's ``ego``'s, else the trace's ego, else the first."""
     for i, o in enumerate(moment.objects):
         if o.program_name == "ego":
+            return i
+    for i, o in enumerate(moment.objects):
+        if o.label_id == moment.ego:
             return i
     return 0
 

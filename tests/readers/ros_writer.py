@@ -9,6 +9,7 @@ definition with every definition it uses, as rosbag2 writes ``ros2msg`` schemas.
 from __future__ import annotations
 
 import uuid
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -161,36 +162,121 @@ class BagWriter:
         self.writer.finish()
 
 
-def tracked_object(object_id: str, kind: str, pose: dict, yaw: float, row: dict) -> dict:
-    """A TrackedObject message (dict) for one state row of a trace (pose in the ego frame)."""
-    velocity_body = row["velocity_body"]
-    cov = [0.0] * 36
+ZERO = {"x": 0.0, "y": 0.0, "z": 0.0}
+COVARIANCE = [0.0] * 36
+
+
+@dataclass(frozen=True)
+class Box:
+    """One object of a frame as a message carries it: pose in the ego frame (``base_link``)."""
+
+    id: str
+    kind: str
+    position: dict
+    yaw: float
+    size: dict
+    velocity_body: dict
+
+
+def tracked_object(box: Box) -> dict:
+    """A TrackedObject message (dict): two classifications, the kind's label the more probable."""
     return {
-        "object_id": {"uuid": list(object_uuid(object_id))},
+        "object_id": {"uuid": list(object_uuid(box.id))},
         "existence_probability": 1.0,
         "classification": [
-            {"label": 0 if KIND_LABEL[kind] else 1, "probability": 0.25},
-            {"label": KIND_LABEL[kind], "probability": 0.75},
+            {"label": 0 if KIND_LABEL[box.kind] else 1, "probability": 0.25},
+            {"label": KIND_LABEL[box.kind], "probability": 0.75},
         ],
         "kinematics": {
-            "pose_with_covariance": {"pose": {"position": pose, "orientation": _quat(yaw)}, "covariance": cov},
+            "pose_with_covariance": {"pose": _pose(box), "covariance": COVARIANCE},
             "twist_with_covariance": {
-                "twist": {"linear": velocity_body, "angular": {"x": 0.0, "y": 0.0, "z": 0.0}},
-                "covariance": cov,
+                "twist": {"linear": box.velocity_body, "angular": ZERO},
+                "covariance": COVARIANCE,
             },
-            "acceleration_with_covariance": {
-                "accel": {"linear": {"x": 0.0, "y": 0.0, "z": 0.0}, "angular": {"x": 0.0, "y": 0.0, "z": 0.0}},
-                "covariance": cov,
-            },
+            "acceleration_with_covariance": {"accel": {"linear": ZERO, "angular": ZERO}, "covariance": COVARIANCE},
             "orientation_availability": 2,
             "is_stationary": False,
         },
         "shape": {
             "type": 0,
-            "footprint": {"points": [{"x": 1.0, "y": 2.0, "z": 0.0}] * (len(object_id) % 3)},
-            "dimensions": {"x": row["length"], "y": row["width"], "z": row["height"]},
+            "footprint": {"points": [{"x": 1.0, "y": 2.0, "z": 0.0}] * (len(box.id) % 3)},
+            "dimensions": box.size,
         },
     }
+
+
+def detected_object(box: Box) -> dict:
+    """A DetectedObject message (dict): no id; the twist given (``has_twist``)."""
+    return {
+        "existence_probability": 1.0,
+        "classification": [{"label": KIND_LABEL[box.kind], "probability": 0.9}],
+        "kinematics": {
+            "pose_with_covariance": {"pose": _pose(box), "covariance": COVARIANCE},
+            "has_position_covariance": False,
+            "orientation_availability": 2,
+            "twist_with_covariance": {
+                "twist": {"linear": box.velocity_body, "angular": ZERO},
+                "covariance": COVARIANCE,
+            },
+            "has_twist": True,
+            "has_twist_covariance": False,
+        },
+        "shape": {"type": 0, "footprint": {"points": []}, "dimensions": box.size},
+    }
+
+
+def _pose(box: Box) -> dict:
+    return {"position": box.position, "orientation": _quat(box.yaw)}
+
+
+def frames_in_ego_frame(trace: LabelTrace) -> list[tuple[dict, list[Box]]]:
+    """Per frame: the ego's pose in the map frame (position dict, yaw) and every other object as a
+    :class:`Box` in the ego's frame (NaN sizes and velocities kept; an unknown z is 0)."""
+    ego = trace.object_index(trace.ego)
+    ex, ey, ez, eh = (trace.dense(c)[:, ego] for c in ("x", "y", "z", "heading"))
+    ez = np.nan_to_num(ez)
+    kinds = trace.objects.kinds()
+    offsets = trace.states.frame_offsets(trace.n_frames)
+    s = trace.states
+    out = []
+    for f in range(trace.n_frames):
+        ego_yaw = float(yaw_from_heading(eh[f]))
+        c, si = np.cos(ego_yaw), np.sin(ego_yaw)
+        boxes = []
+        for r in range(offsets[f], offsets[f + 1]):
+            o = int(s.object[r])
+            if o == ego:
+                continue
+            dx, dy, dz = s.x[r] - ex[f], s.y[r] - ey[f], np.nan_to_num(s.z[r]) - ez[f]
+            yaw = float(yaw_from_heading(s.heading[r]))
+            cb, sb = np.cos(yaw), np.sin(yaw)
+            vx, vy = float(s.vx[r]), float(s.vy[r])
+            boxes.append(
+                Box(
+                    str(trace.objects.id[o]),
+                    str(kinds[o]),
+                    {"x": c * dx + si * dy, "y": -si * dx + c * dy, "z": float(dz)},
+                    yaw - ego_yaw,
+                    {"x": float(s.length[r]), "y": float(s.width[r]), "z": float(s.height[r])},
+                    {"x": cb * vx + sb * vy, "y": -sb * vx + cb * vy, "z": 0.0},
+                )
+            )
+        ego_pose = {"x": float(ex[f]), "y": float(ey[f]), "z": float(ez[f])}
+        out.append(((ego_pose, ego_yaw), boxes))
+    return out
+
+
+BOX_MESSAGES = {
+    "autoware_perception_msgs/TrackedObjects": (
+        TRACKED_TOPIC,
+        lambda boxes: {"objects": [tracked_object(b) for b in boxes]},
+    ),
+    "autoware_perception_msgs/DetectedObjects": (
+        "/perception/object_recognition/detection/objects",
+        lambda boxes: {"objects": [detected_object(b) for b in boxes]},
+    ),
+}
+"""Per box message type: its topic and the message body of a frame's boxes."""
 
 
 def write_tracked(
@@ -199,63 +285,42 @@ def write_tracked(
     origin_ns: int = ORIGIN_NS,
     drop: frozenset[int] = frozenset(),
     late_tf: bool = False,
+    box_type: str = "autoware_perception_msgs/TrackedObjects",
+    ego_topic: str = "/tf",
 ) -> None:
-    """Write a trace as :data:`TRACKED_TOPIC` (TrackedObjects, boxes
-    in the ``base_link`` frame of the ego) and ``/tf`` (map <- base_link, the ego's pose), one of
-    each per frame, logged 20 ms after the frame's stamp. ``drop``: frame positions whose
-    TrackedObjects message is not written; ``late_tf``: each frame's /tf message is written after
-    the next frame's objects (out of order)."""
+    """Write a trace as boxes of ``box_type`` (default TrackedObjects on :data:`TRACKED_TOPIC`),
+    in the ``base_link`` frame of the ego, and the ego's pose (map <- base_link) on ``/tf`` or, for
+    another ``ego_topic``, as ``nav_msgs/Odometry``; one of each per frame, logged 20 ms after the
+    frame's stamp. ``drop``: frame positions whose box message is not written; ``late_tf``: each
+    frame's /tf message is written after the next frame's boxes (out of order)."""
     writer = BagWriter(path)
     stamps = frame_stamps(trace, origin_ns)
-    ego = trace.object_index(trace.ego)
-    ex, ey, ez, eh = (trace.dense(c)[:, ego] for c in ("x", "y", "z", "heading"))
-    ez = np.nan_to_num(ez)
-    kinds = trace.objects.kinds()
-    offsets = trace.states.frame_offsets(trace.n_frames)
-    s = trace.states
+    topic, body = BOX_MESSAGES[box_type]
     pending_tf = None
-    for f in range(trace.n_frames):
-        ego_yaw = float(yaw_from_heading(eh[f]))
-        c, si = np.cos(ego_yaw), np.sin(ego_yaw)
-        tf = {
-            "transforms": [
-                {
-                    "header": {"stamp": _stamp(int(stamps[f])), "frame_id": "map"},
-                    "child_frame_id": "base_link",
-                    "transform": {
-                        "translation": {"x": float(ex[f]), "y": float(ey[f]), "z": float(ez[f])},
-                        "rotation": _quat(ego_yaw),
-                    },
-                }
-            ]
-        }
-        objects = []
-        for r in range(offsets[f], offsets[f + 1]):
-            o = int(s.object[r])
-            if o == ego:
-                continue
-            dx, dy, dz = s.x[r] - ex[f], s.y[r] - ey[f], np.nan_to_num(s.z[r]) - ez[f]
-            yaw = float(yaw_from_heading(s.heading[r]))
-            vx, vy = float(s.vx[r]), float(s.vy[r])
-            cb, sb = np.cos(yaw), np.sin(yaw)
-            row = {
-                "length": float(s.length[r]),
-                "width": float(s.width[r]),
-                "height": float(s.height[r]),
-                "velocity_body": {"x": cb * vx + sb * vy, "y": -sb * vx + cb * vy, "z": 0.0},
-            }
-            pose = {"x": c * dx + si * dy, "y": -si * dx + c * dy, "z": float(dz)}
-            objects.append(tracked_object(str(trace.objects.id[o]), str(kinds[o]), pose, yaw - ego_yaw, row))
+    for f, ((ego_pose, ego_yaw), boxes) in enumerate(frames_in_ego_frame(trace)):
+        header = {"stamp": _stamp(int(stamps[f])), "frame_id": "map"}
+        if ego_topic == "/tf":
+            link = {"translation": ego_pose, "rotation": _quat(ego_yaw)}
+            ego = (
+                "/tf",
+                "tf2_msgs/TFMessage",
+                {"transforms": [{"header": header, "child_frame_id": "base_link", "transform": link}]},
+            )
+        else:
+            pose = {"pose": {"position": ego_pose, "orientation": _quat(ego_yaw)}, "covariance": COVARIANCE}
+            twist = {"twist": {"linear": ZERO, "angular": ZERO}, "covariance": COVARIANCE}
+            message = {"header": header, "child_frame_id": "base_link", "pose": pose, "twist": twist}
+            ego = (ego_topic, "nav_msgs/Odometry", message)
         log = int(stamps[f]) + 20_000_000
         if not late_tf:
-            writer.write("/tf", "tf2_msgs/TFMessage", tf, log)
+            writer.write(*ego, log)
         if f not in drop:
-            message = {"header": {"stamp": _stamp(int(stamps[f])), "frame_id": "base_link"}, "objects": objects}
-            writer.write(TRACKED_TOPIC, "autoware_perception_msgs/TrackedObjects", message, log)
+            message = {"header": {"stamp": _stamp(int(stamps[f])), "frame_id": "base_link"}, **body(boxes)}
+            writer.write(topic, box_type, message, log)
         if late_tf:
             if pending_tf is not None:
-                writer.write("/tf", "tf2_msgs/TFMessage", *pending_tf)
-            pending_tf = (tf, log)
+                writer.write(*pending_tf)
+            pending_tf = (*ego, log)
     if pending_tf is not None:
-        writer.write("/tf", "tf2_msgs/TFMessage", *pending_tf)
+        writer.write(*pending_tf)
     writer.close()

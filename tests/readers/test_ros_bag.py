@@ -214,3 +214,27 @@ def test_info_lists_topics_and_the_options_reach_the_reader(av2, capsys):
     assert main(["info", str(path), "--rate", "2", "--frame-topic", TOPIC]) == 2
     assert "give --rate or --frame-topic, not both" in capsys.readouterr().err
     assert main(["info", str(path), "--rate", "nan"]) == 2
+
+
+def test_detected_objects_with_odometry_give_back_every_observation(short):
+    """DetectedObjects carry no ids: each observation is an object ``<stamp ns>:<rank>``; the ego
+    comes from a nav_msgs/Odometry topic instead of /tf."""
+    trace, folder = short
+    path = folder / "detected.mcap"
+    write_tracked(trace, path, ORIGIN, box_type="autoware_perception_msgs/DetectedObjects", ego_topic="/odom")
+    bag = readers.read_trace(path)
+    stamps = frame_stamps(trace, ORIGIN)
+    s, b = trace.states, bag.states
+    ego = trace.object_index(trace.ego)
+    rows = bag.objects.row_of()
+    for f in range(trace.n_frames):
+        mine = np.flatnonzero((s.frame == f) & (s.object != ego))
+        theirs = np.array([rows[f"{stamps[f]}:{k}"] for k in range(len(mine))])
+        at = np.searchsorted(b.frame * bag.n_objects + b.object, f * bag.n_objects + theirs)
+        for column in ("x", "y", "length", "width", "height", "vx", "vy"):
+            np.testing.assert_allclose(getattr(b, column)[at], getattr(s, column)[mine], atol=1e-6, equal_nan=True)
+        assert np.abs(heading_difference(b.heading[at], s.heading[mine])).max() < 1e-9
+        assert bag.objects.kinds()[theirs].tolist() == trace.objects.kinds()[s.object[mine]].tolist()
+    ego_rows = b.object == rows["ego"]
+    np.testing.assert_allclose(b.x[ego_rows], s.x[s.object == ego], atol=1e-6)
+    assert bag.n_objects == np.sum(s.object != ego) + 1

@@ -72,6 +72,13 @@ MSG = {
         "DetectedObjectKinematics kinematics\nShape shape"
     ),
     "autoware_perception_msgs/DetectedObjects": "std_msgs/Header header\nDetectedObject[] objects",
+    "vision_msgs/ObjectHypothesis": "string class_id\nfloat64 score",
+    "vision_msgs/ObjectHypothesisWithPose": "ObjectHypothesis hypothesis\ngeometry_msgs/PoseWithCovariance pose",
+    "vision_msgs/BoundingBox3D": "geometry_msgs/Pose center\ngeometry_msgs/Vector3 size",
+    "vision_msgs/Detection3D": (
+        "std_msgs/Header header\nObjectHypothesisWithPose[] results\nBoundingBox3D bbox\nstring id"
+    ),
+    "vision_msgs/Detection3DArray": "std_msgs/Header header\nDetection3D[] detections",
 }
 
 KIND_LABEL = {
@@ -172,6 +179,7 @@ class Box:
 
     id: str
     kind: str
+    category: str
     position: dict
     yaw: float
     size: dict
@@ -225,6 +233,17 @@ def detected_object(box: Box) -> dict:
     }
 
 
+def detection3d(box: Box, header: dict) -> dict:
+    """A vision_msgs Detection3D (dict): two hypotheses, the object's class the more probable; its
+    tracking id; its own header (the array's)."""
+    pose = {"pose": _pose(box), "covariance": COVARIANCE}
+    results = [
+        {"hypothesis": {"class_id": "unknown", "score": 0.2}, "pose": pose},
+        {"hypothesis": {"class_id": box.category, "score": 0.8}, "pose": pose},
+    ]
+    return {"header": header, "results": results, "bbox": {"center": _pose(box), "size": box.size}, "id": box.id}
+
+
 def _pose(box: Box) -> dict:
     return {"position": box.position, "orientation": _quat(box.yaw)}
 
@@ -255,6 +274,7 @@ def frames_in_ego_frame(trace: LabelTrace) -> list[tuple[dict, list[Box]]]:
                 Box(
                     str(trace.objects.id[o]),
                     str(kinds[o]),
+                    str(trace.objects.category[o]),
                     {"x": c * dx + si * dy, "y": -si * dx + c * dy, "z": float(dz)},
                     yaw - ego_yaw,
                     {"x": float(s.length[r]), "y": float(s.width[r]), "z": float(s.height[r])},
@@ -269,11 +289,15 @@ def frames_in_ego_frame(trace: LabelTrace) -> list[tuple[dict, list[Box]]]:
 BOX_MESSAGES = {
     "autoware_perception_msgs/TrackedObjects": (
         TRACKED_TOPIC,
-        lambda boxes: {"objects": [tracked_object(b) for b in boxes]},
+        lambda boxes, header: {"objects": [tracked_object(b) for b in boxes]},
     ),
     "autoware_perception_msgs/DetectedObjects": (
         "/perception/object_recognition/detection/objects",
-        lambda boxes: {"objects": [detected_object(b) for b in boxes]},
+        lambda boxes, header: {"objects": [detected_object(b) for b in boxes]},
+    ),
+    "vision_msgs/Detection3DArray": (
+        "/detections_3d",
+        lambda boxes, header: {"detections": [detection3d(b, header) for b in boxes]},
     ),
 }
 """Per box message type: its topic and the message body of a frame's boxes."""
@@ -315,7 +339,8 @@ def write_tracked(
         if not late_tf:
             writer.write(*ego, log)
         if f not in drop:
-            message = {"header": {"stamp": _stamp(int(stamps[f])), "frame_id": "base_link"}, **body(boxes)}
+            box_header = {"stamp": _stamp(int(stamps[f])), "frame_id": "base_link"}
+            message = {"header": box_header, **body(boxes, box_header)}
             writer.write(topic, box_type, message, log)
         if late_tf:
             if pending_tf is not None:

@@ -38,16 +38,23 @@ def short(av2, tmp_path_factory) -> tuple[LabelTrace, Path]:
     return trace, tmp_path_factory.mktemp("short")
 
 
-def assert_same(original: LabelTrace, bag: LabelTrace, frames: np.ndarray | None = None) -> None:
-    """``bag`` holds ``original``'s frames (all, or the positions ``frames``): the same objects,
-    kinds, positions (1e-6 m), headings, sizes and velocities (the ego's pose only), times."""
+def assert_same(
+    original: LabelTrace,
+    bag: LabelTrace,
+    frames: np.ndarray | None = None,
+    id_of=read_back_id,
+    velocity: bool = True,
+) -> None:
+    """``bag`` holds ``original``'s frames (all, or the positions ``frames``): the same objects
+    (``id_of``: the id the bag gives an original id), kinds, positions (1e-6 m), headings, sizes
+    and velocities (unless the messages carry none: ``velocity``; the ego's pose only), times."""
     if frames is not None:
         keep = np.zeros(original.n_frames, dtype=bool)
         keep[frames] = True
         original = original.select_frames(keep)
     assert bag.n_frames == original.n_frames
     np.testing.assert_allclose(bag.frame_time, original.frame_time - original.frame_time[0], atol=1e-9)
-    ids = ["ego" if i == original.ego else read_back_id(i) for i in original.objects.id]
+    ids = ["ego" if i == original.ego else id_of(i) for i in original.objects.id]
     rows = bag.objects.row_of()
     present = np.bincount(original.states.object, minlength=original.n_objects) > 0
     assert sorted(rows) == sorted(np.array(ids)[present].tolist())
@@ -67,11 +74,13 @@ def assert_same(original: LabelTrace, bag: LabelTrace, frames: np.ndarray | None
     np.testing.assert_allclose(b.z, np.nan_to_num(s.z[order]), rtol=0, atol=1e-6)
     assert np.abs(heading_difference(b.heading, s.heading[order])).max() < 1e-9
     not_ego = b.object != rows["ego"]
-    for column in ("length", "width", "height", "vx", "vy"):
+    for column in ("length", "width", "height", "vx", "vy")[: 5 if velocity else 3]:
         np.testing.assert_allclose(
             getattr(b, column)[not_ego], getattr(s, column)[order][not_ego], rtol=0, atol=1e-6, equal_nan=True
         )
     assert np.isnan(b.length[~not_ego]).all()  # /tf carries no ego size
+    if not velocity:
+        assert np.isnan(b.vx).all()
 
 
 def test_tracked_objects_and_tf_give_back_the_trace(av2):
@@ -238,3 +247,13 @@ def test_detected_objects_with_odometry_give_back_every_observation(short):
     ego_rows = b.object == rows["ego"]
     np.testing.assert_allclose(b.x[ego_rows], s.x[s.object == ego], atol=1e-6)
     assert bag.n_objects == np.sum(s.object != ego) + 1
+
+
+def test_vision_detection3d_arrays_give_back_the_trace_with_its_ids_and_classes(short):
+    trace, folder = short
+    path = folder / "vision.mcap"
+    write_tracked(trace, path, ORIGIN, box_type="vision_msgs/Detection3DArray")
+    bag = readers.read_trace(path)
+    assert_same(trace, bag, id_of=str, velocity=False)
+    classes = dict(zip(trace.objects.id, trace.objects.category))
+    assert all(classes[i] == c for i, c in zip(bag.objects.id, bag.objects.category) if i != "ego")

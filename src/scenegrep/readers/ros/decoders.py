@@ -11,6 +11,9 @@ field order or added field of a message version is read right). Supported types 
 - ``autoware_perception_msgs/DetectedObjects`` (and the ``autoware_auto`` name): as above,
   without ids (each detection gets its own id ``<stamp ns>:<rank>``) and with the twist only
   where ``has_twist`` is set;
+- ``vision_msgs/Detection3DArray``: the box (centre pose, size), the most probable hypothesis's
+  ``class_id`` as the class, ``id`` (the tracking id; ``<stamp ns>:<rank>`` where empty), each
+  detection's own header where it has one (frame id not empty, stamp not zero);
 - ``tf2_msgs/TFMessage`` (``/tf``, ``/tf_static``) and ``nav_msgs/Odometry`` (a link from its
   ``header.frame_id`` to its ``child_frame_id``).
 
@@ -75,17 +78,27 @@ def _vector(fields: dict[str, np.ndarray], prefix: str, names: Sequence[str], ro
     return np.stack([fields[prefix + n].astype(np.float64)[rows] for n in names], axis=1)
 
 
-def _best_class(levels: dict[str, Level], n_objects: int) -> np.ndarray:
-    """The most probable label of every object (decode order; UNKNOWN without a classification;
-    the first of equally probable ones)."""
-    best = np.zeros(n_objects, dtype=np.int64)
-    classes = levels.get("objects.classification")
-    if classes is not None and len(classes.parent):
-        order = np.lexsort((classes.rank, -classes.fields["probability"].astype(np.float64), classes.parent))
-        parent = classes.parent[order]
+def _best(level: Level | None, score: str, n_items: int) -> np.ndarray:
+    """Per parent item (0..n_items-1), the row of ``level`` with the highest ``score`` (the first
+    of equal ones), -1 for a parent without rows."""
+    best = np.full(n_items, -1, dtype=np.int64)
+    if level is not None and len(level.parent):
+        order = np.lexsort((level.rank, -level.fields[score].astype(np.float64), level.parent))
+        parent = level.parent[order]
         first = np.r_[True, parent[1:] != parent[:-1]]
-        best[parent[first]] = classes.fields["label"][order][first]
-    return np.where(best < len(AUTOWARE_LABELS), best, 0)
+        best[parent[first]] = order[first]
+    return best
+
+
+def _best_class(levels: dict[str, Level], n_objects: int) -> np.ndarray:
+    """The most probable Autoware label of every object (decode order; UNKNOWN without a
+    classification or past the known labels)."""
+    classes = levels.get("objects.classification")
+    best = _best(classes, "probability", n_objects)
+    label = np.zeros(n_objects, dtype=np.int64)
+    if classes is not None:
+        label[best >= 0] = classes.fields["label"][best[best >= 0]]
+    return np.where(label < len(AUTOWARE_LABELS), label, 0)
 
 
 def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:
@@ -154,6 +167,50 @@ def _no_boxes(stamps: np.ndarray) -> Boxes:
     return Boxes(empty, empty, text, text, text, vectors, np.empty((0, 4)), vectors, vectors, stamps)
 
 
+def _vision3d() -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:
+    stamp = ("header.stamp.sec", "header.stamp.nanosec", "header.frame_id")
+    wanted = {*stamp, *(f"detections.{n}" for n in stamp), "detections.id"}
+    wanted |= {f"detections.bbox.center.position.{a}" for a in _XYZ}
+    wanted |= {f"detections.bbox.center.orientation.{a}" for a in "xyzw"}
+    wanted |= {f"detections.bbox.size.{a}" for a in _XYZ}
+    wanted |= {"detections.results.hypothesis.class_id", "detections.results.hypothesis.score"}
+
+    def boxes(levels: dict[str, Level]) -> Boxes:
+        top, found = levels[""], levels.get("detections")
+        stamps, frames = _stamp(top.fields), _frames(top.fields["header.frame_id"])
+        if found is None or not len(found.parent):
+            return _no_boxes(stamps)
+        rows = _ordered(found)
+        f = found.fields
+        message = found.parent[rows]
+        own_stamp, own_frame = _stamp(f)[rows], _frames(f["header.frame_id"][rows])
+        row_stamp = np.where(own_stamp > 0, own_stamp, stamps[message])
+        row_frame = np.where(own_frame != "", own_frame, frames[message])
+        results = levels.get("detections.results")
+        best = _best(results, "hypothesis.score", len(found.parent))[rows]
+        category = np.full(len(rows), "unknown", dtype=object)
+        if results is not None:
+            category[best >= 0] = results.fields["hypothesis.class_id"][best[best >= 0]]
+        given = f["id"][rows]
+        ids = np.array(
+            [i if i else f"{s}:{r}" for i, s, r in zip(given, stamps[message], found.rank[rows])], dtype=object
+        )
+        return Boxes(
+            message,
+            row_stamp,
+            row_frame,
+            ids,
+            category,
+            _vector(f, "bbox.center.position.", _XYZ, rows),
+            _vector(f, "bbox.center.orientation.", "xyzw", rows),
+            _vector(f, "bbox.size.", _XYZ, rows),
+            np.full((len(rows), 3), np.nan),
+            stamps,
+        )
+
+    return frozenset(wanted), boxes
+
+
 def _tf() -> tuple[frozenset[str], Callable[[dict[str, Level]], Transforms]]:
     prefix = "transforms."
     wanted = {prefix + n for n in ("header.stamp.sec", "header.stamp.nanosec", "header.frame_id", "child_frame_id")}
@@ -206,6 +263,7 @@ _DECODERS: dict[str, Callable[[], tuple[frozenset[str], Callable[[dict[str, Leve
     "autoware_auto_perception_msgs/TrackedObjects": lambda: _autoware(True),
     "autoware_perception_msgs/DetectedObjects": lambda: _autoware(False),
     "autoware_auto_perception_msgs/DetectedObjects": lambda: _autoware(False),
+    "vision_msgs/Detection3DArray": _vision3d,
     "tf2_msgs/TFMessage": _tf,
     "nav_msgs/Odometry": _odometry,
 }

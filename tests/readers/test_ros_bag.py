@@ -20,7 +20,7 @@ from scenegrep.readers.ros.options import BagOptions
 from scenegrep.readers.ros.reader import read_trace
 
 from .ros_writer import TRACKED_TOPIC as TOPIC
-from .ros_writer import ORIGIN_NS, BagWriter, frame_stamps, read_back_id, write_tracked
+from .ros_writer import ORIGIN_NS, BagWriter, frame_stamps, read_back_id, write_scene_updates, write_tracked
 
 NUSCENES = "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl"
 ORIGIN = ORIGIN_NS
@@ -195,8 +195,9 @@ def test_a_message_that_does_not_fit_its_schema_names_topic_and_log_time(short, 
     assert f"topic {TOPIC}, message at log time {messages[target].log_time} ns: truncated" in error.value.one_line()
 
 
-def _copy(messages, path: Path, extra_schema: bytes | None = None) -> None:
-    """Write raw messages again (their schemas from the messages themselves)."""
+def _copy(messages, path: Path, extra_schema: bytes | None = None, encodings: dict | None = None) -> None:
+    """Write raw messages again (their schemas from the messages themselves; message encodings
+    ``cdr`` unless ``encodings`` names another for a topic)."""
     writer = BagWriter(path)
     mcap = writer.writer._writer
     schemas: dict[str, int] = {}
@@ -204,8 +205,10 @@ def _copy(messages, path: Path, extra_schema: bytes | None = None) -> None:
     for m in messages:
         if m.topic not in channels:
             data = extra_schema if m.topic == "/weird" else m.schema_data
-            schemas.setdefault(m.schema_name, mcap.register_schema(m.schema_name, "ros2msg", data))
-            channels[m.topic] = mcap.register_channel(m.topic, "cdr", schemas[m.schema_name])
+            schemas.setdefault(m.schema_name, mcap.register_schema(m.schema_name, m.schema_encoding, data))
+            channels[m.topic] = mcap.register_channel(
+                m.topic, (encodings or {}).get(m.topic, "cdr"), schemas[m.schema_name]
+            )
         mcap.add_message(channels[m.topic], m.log_time, m.data, m.log_time)
     writer.close()
 
@@ -257,3 +260,41 @@ def test_vision_detection3d_arrays_give_back_the_trace_with_its_ids_and_classes(
     assert_same(trace, bag, id_of=str, velocity=False)
     classes = dict(zip(trace.objects.id, trace.objects.category))
     assert all(classes[i] == c for i, c in zip(bag.objects.id, bag.objects.category) if i != "ego")
+
+
+@pytest.mark.parametrize("encoding", ["json", "protobuf"])
+def test_foxglove_scene_updates_give_back_the_trace(short, encoding):
+    trace, folder = short
+    path = folder / f"scene_{encoding}.mcap"
+    write_scene_updates(trace, path, encoding)
+    bag = readers.read_trace(path)
+    assert_same(trace, bag, id_of=str, velocity=False)
+    classes = dict(zip(trace.objects.id, trace.objects.category))
+    assert all(classes[i] == c for i, c in zip(bag.objects.id, bag.objects.category) if i != "ego")
+
+
+@pytest.mark.parametrize(
+    ("data", "reason"),
+    [
+        (b"{not json", "not JSON"),
+        (b'{"entities": 3}', "entities must be a list of objects"),
+        (b'{"entities": [{"cubes": [{"size": {"x": "big"}}]}]}', "entities[0].cubes[0].size.x is str, not a number"),
+        (b"[" * 100_000, "not JSON"),
+    ],
+)
+def test_a_malformed_scene_update_names_topic_and_log_time(short, tmp_path, data, reason):
+    trace, folder = short
+    path = folder / "scene_json.mcap"
+    if not path.exists():
+        write_scene_updates(trace, path, "json")
+    messages = list(bag_messages(path))
+    target = next(i for i, m in enumerate(messages) if m.topic == "/markers" and i > 6)
+    messages[target] = messages[target]._replace(data=data)
+    _copy(messages, tmp_path / "bad.mcap", encodings={"/markers": "json"})
+    with pytest.raises(UserError) as error:
+        readers.read_trace(tmp_path / "bad.mcap")
+    line = error.value.one_line()
+    assert (
+        f"topic /markers, message at log time {messages[target].log_time} ns: not a valid foxglove.SceneUpdate" in line
+    )
+    assert reason in line

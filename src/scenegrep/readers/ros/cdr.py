@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .messages import DecodeError
 from .msgdef import PRIMITIVE_SIZES, STRINGS, Field
 
 _DTYPES = {
@@ -49,13 +50,8 @@ ALIGN = 8
 """The largest CDR alignment: payload origins in a batch's buffer are multiples of it."""
 
 
-class CdrError(ValueError):
-    """A message that cannot be decoded: ``message`` is its position in the batch."""
-
-    def __init__(self, message: int, reason: str):
-        super().__init__(reason)
-        self.message = message
-        self.reason = reason
+class CdrError(DecodeError):
+    """A CDR message that cannot be decoded: ``message`` is its position in the batch."""
 
 
 @dataclass

@@ -14,6 +14,7 @@ field order or added field of a message version is read right). Supported types 
 - ``vision_msgs/Detection3DArray``: the box (centre pose, size), the most probable hypothesis's
   ``class_id`` as the class, ``id`` (the tracking id; ``<stamp ns>:<rank>`` where empty), each
   detection's own header where it has one (frame id not empty, stamp not zero);
+- ``foxglove.SceneUpdate`` in JSON or protobuf (:mod:`.foxglove`): cube entities;
 - ``tf2_msgs/TFMessage`` (``/tf``, ``/tf_static``) and ``nav_msgs/Odometry`` (a link from its
   ``header.frame_id`` to its ``child_frame_id``).
 
@@ -29,7 +30,8 @@ from functools import lru_cache
 import numpy as np
 
 from .cdr import Level, Payloads, decode
-from .messages import Boxes, Transforms
+from .foxglove import SCENE_UPDATE, decode_scene_updates
+from .messages import Boxes, RawMessage, Transforms
 from .msgdef import Field, normalise, parse_schema
 
 AUTOWARE_LABELS = (
@@ -268,7 +270,7 @@ _DECODERS: dict[str, Callable[[], tuple[frozenset[str], Callable[[dict[str, Leve
     "nav_msgs/Odometry": _odometry,
 }
 
-BOX_TYPES = frozenset(name for name in _DECODERS if not name.startswith(("tf2_msgs", "nav_msgs")))
+BOX_TYPES = frozenset(name for name in (*_DECODERS, SCENE_UPDATE) if not name.startswith(("tf2_msgs", "nav_msgs")))
 """The message types that give boxes."""
 
 LINK_TYPES = frozenset({"tf2_msgs/TFMessage", "nav_msgs/Odometry"})
@@ -276,18 +278,26 @@ LINK_TYPES = frozenset({"tf2_msgs/TFMessage", "nav_msgs/Odometry"})
 
 
 def type_key(schema_name: str) -> str:
-    """``pkg/Type`` of a schema name (``pkg/msg/Type`` accepted)."""
-    return normalise(schema_name, "")
+    """``pkg/Type`` of a ROS schema name (``pkg/msg/Type`` accepted); a protobuf or JSON schema
+    name (``foxglove.SceneUpdate``) as it is."""
+    return schema_name if "/" not in schema_name else normalise(schema_name, "")
 
 
 def supported(schema_name: str, message_encoding: str) -> bool:
     """Whether messages of this schema and encoding are decoded."""
+    if schema_name == SCENE_UPDATE:
+        return message_encoding in ("json", "protobuf")
     return message_encoding == "cdr" and type_key(schema_name) in _DECODERS
 
 
-def decode_cdr(schema_name: str, schema_data: bytes, payloads: Sequence[bytes]) -> Boxes | Transforms:
-    """The boxes or links of a batch of CDR messages of one supported schema (CdrError names the
-    first bad message; DefinitionError a schema that cannot be read or lacks a field)."""
-    wanted, build = _DECODERS[type_key(schema_name)]()
-    levels = decode(types_of(schema_name, schema_data), type_key(schema_name), Payloads.of(payloads), wanted)
-    return build(levels)
+def decode_batch(messages: Sequence[RawMessage]) -> Boxes | Transforms:
+    """The boxes or links of a batch of messages of one topic (one supported schema and encoding):
+    DecodeError names the first bad message; DefinitionError a schema that cannot be read; KeyError
+    a field the decoder needs that the schema lacks."""
+    first = messages[0]
+    if first.schema_name == SCENE_UPDATE:
+        return decode_scene_updates(messages)
+    key = type_key(first.schema_name)
+    wanted, build = _DECODERS[key]()
+    payloads = Payloads.of([m.data for m in messages])
+    return build(decode(types_of(first.schema_name, first.schema_data), key, payloads, wanted))

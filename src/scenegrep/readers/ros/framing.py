@@ -41,9 +41,8 @@ import pyarrow as pa
 from ...errors import UserError
 from ...model import LabelTrace, ObjectTable, StateTable, TraceSource
 from ...model.geometry import heading_from_yaw
-from .cdr import CdrError
-from .decoders import BOX_TYPES, LINK_TYPES, decode_cdr, supported, type_key
-from .messages import Boxes, RawMessage
+from .decoders import BOX_TYPES, LINK_TYPES, decode_batch, supported, type_key
+from .messages import Boxes, DecodeError, RawMessage
 from .msgdef import DefinitionError
 from .options import BagOptions
 from .transforms import MissingTransform, TfBuffer, quat_multiply, quat_rotate, yaw_of
@@ -132,11 +131,11 @@ class FrameBuilder:
         for m in messages:
             if len(m.data) > MAX_MESSAGE_BYTES:
                 raise _fail(topic, m.log_time, f"a message of {len(m.data)} bytes (at most {MAX_MESSAGE_BYTES})")
-            if m.schema_name != first.schema_name:
+            if (m.schema_name, m.message_encoding) != (first.schema_name, first.message_encoding):
                 raise _fail(topic, m.log_time, f"type {m.schema_name} on a topic of type {first.schema_name}")
         try:
-            decoded = decode_cdr(first.schema_name, first.schema_data, [m.data for m in messages])
-        except CdrError as exc:
+            decoded = decode_batch(messages)
+        except DecodeError as exc:
             raise _fail(topic, messages[exc.message].log_time, exc.reason) from None
         except DefinitionError as exc:
             raise _fail(topic, first.log_time, f"schema {first.schema_name}: {exc}") from None

@@ -15,7 +15,16 @@ import numpy as np
 
 from ..mcap_follow import RawMessage
 
-__all__ = ["Boxes", "RawMessage", "Transforms"]
+__all__ = ["Boxes", "DecodeError", "RawMessage", "Transforms"]
+
+
+class DecodeError(ValueError):
+    """A message of a batch that cannot be decoded: ``message`` is its position in the batch."""
+
+    def __init__(self, message: int, reason: str):
+        super().__init__(reason)
+        self.message = message
+        self.reason = reason
 
 
 @dataclass(frozen=True)

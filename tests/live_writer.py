@@ -2,13 +2,14 @@
 
     python tests/live_writer.py OUT.mcap PLAN.json
 
-PLAN: ``{"pause": S, "messages": [{"topic", "schema", "encoding", "schema_data" (base64), "data"
-(base64), "log_time" (ns)}]}``. The writer creates OUT with the MCAP header, prints ``ready`` and waits
-for a line on its standard input; then it appends the messages one by one, unchunked, each record in
-two writes 3 ms apart (a reader polling the file sees half-written records), prints ``K T`` after the
-K-th message's last byte is written (T: ``time.monotonic()``, the system-wide monotonic clock that
-the test reads too) and sleeps ``pause`` seconds; at the end it writes the summary and footer and
-prints ``done``.
+PLAN: ``{"pause": S, "messages": [...]}``, each message a
+:class:`~scenegrep.readers.mcap_follow.RawMessage` as a dict, its bytes in base64. The writer
+creates OUT with the MCAP header, prints ``ready`` and waits for a line on its standard input;
+then it appends the messages one by one, unchunked, each record in two writes 3 ms apart (a
+reader polling the file sees half-written records), prints ``K T`` after the K-th message's last
+byte is written (T: ``time.monotonic()``, the system-wide monotonic clock that the test reads
+too) and sleeps ``pause`` seconds; at the end it writes the summary and footer and prints
+``done``.
 """
 
 from __future__ import annotations
@@ -48,12 +49,9 @@ def main(out: str, plan_path: str) -> None:
     for number, message in enumerate(plan["messages"]):
         topic = message["topic"]
         if topic not in channels:
-            schema = writer.register_schema(
-                message["schema"],
-                message.get("schema_encoding", "jsonschema"),
-                base64.b64decode(message["schema_data"]),
-            )
-            channels[topic] = writer.register_channel(topic, message["encoding"], schema)
+            data = base64.b64decode(message["schema_data"])
+            schema = writer.register_schema(message["schema_name"], message["schema_encoding"], data)
+            channels[topic] = writer.register_channel(topic, message["message_encoding"], schema)
         log_time = message["log_time"]
         writer.add_message(
             channels[topic], log_time=log_time, data=base64.b64decode(message["data"]), publish_time=log_time

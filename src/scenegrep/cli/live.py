@@ -3,7 +3,8 @@ as it is written (``--follow FILE``) or read from standard input, decoded into c
 each frame's latency.
 
 Standard input is an MCAP stream when it starts with MCAP's magic bytes, else the commands' JSON
-documents as before. MCAP messages become frames by :func:`scenegrep.readers.mcap_documents.document_chunks`.
+documents as before. MCAP messages become frames by :func:`scenegrep.readers.live_frames.live_chunks` (JSON document
+channels, and the bag pipeline with the bag options in force).
 While a live input is read, SIGTERM stops the command as Ctrl-C does, and either ends it cleanly: what
 was matched stands (exit code 0 or 1), the latency line is printed.
 
@@ -23,6 +24,7 @@ import sys
 import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any, BinaryIO, TypeVar
 
 T = TypeVar("T")
@@ -131,12 +133,15 @@ def standard_input() -> tuple[bool, BinaryIO]:
 
 def mcap_chunks(path: str, args: argparse.Namespace, stdin: BinaryIO | None = None) -> tuple[Iterator[Any], Latency]:
     """The frames of the MCAP stream at ``path`` (``-``: ``stdin``) as chunks, and their latency meter."""
-    from ..readers.mcap_documents import document_chunks
+    from ..model import TraceSource
+    from ..readers.live_frames import live_chunks
     from ..readers.mcap_follow import FollowOptions, follow_mcap
 
     messages = follow_mcap(path, FollowOptions(idle_timeout=args.idle_timeout), stdin)
     latency = Latency(lambda: messages.arrival)
-    return latency.chunks(document_chunks(messages, _note)), latency
+    name = "stdin" if path == "-" else Path(path).stem
+    chunks = live_chunks(messages, name, TraceSource(messages.name, "ros-bag"), _note)
+    return latency.chunks(chunks), latency
 
 
 def _note(text: str) -> None:

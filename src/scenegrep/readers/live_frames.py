@@ -1,0 +1,36 @@
+"""The frames of a live MCAP stream, each as soon as it is complete (the online commands' input).
+
+A message on a document channel (:mod:`.mcap_documents`) is decoded at once into its frames. Every
+other message goes to the bag pipeline (:mod:`.ros.framing`, with the options in force,
+:func:`.ros.options.current`) one message at a time, so a frame comes out as soon as the pipeline
+has it complete: when its frame-topic message has arrived and the transforms at its stamp are
+known; the frames it still holds come out when the stream ends. The pipeline notes unsupported
+topics and late messages at the end, through ``note``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+
+from ..model import LabelTrace, TraceSource
+from .mcap_documents import document_frames
+from .mcap_follow import RawMessage
+
+
+def live_chunks(
+    messages: Iterable[RawMessage], name: str, source: TraceSource, note: Callable[[str], None]
+) -> Iterator[LabelTrace]:
+    """Chunks of frames in the order they complete (see the module docstring)."""
+    from .ros.framing import FrameBuilder
+    from .ros.options import current
+
+    builder = FrameBuilder(current(), name, source, note)
+    for message in messages:
+        chunk = document_frames(message)
+        if chunk is None:
+            chunk = builder.feed([message])
+        if chunk is not None:
+            yield chunk
+    chunk = builder.finish()
+    if chunk is not None:
+        yield chunk

@@ -25,6 +25,7 @@ import pytest
 from mcap.writer import CompressionType, Writer
 
 from scenegrep import readers
+from scenegrep.cli.live import Latency
 from scenegrep.cli.main import main
 from scenegrep.readers.mcap_documents import STREM_SCHEMA, TRACE_SCHEMA
 from scenegrep.readers.mcap_follow import RawMessage, follow_mcap
@@ -248,7 +249,7 @@ def test_mcap_on_standard_input_with_other_topics_noted(monkeypatch, capsys, fil
     data = mcap_file(strem_messages(), noise=True)
     code, lines, err = stdin_run(monkeypatch, capsys, data, ["spre", "--online", "[[:car:]][[:pedestrian:]]"])
     assert (code, lines) == (0, ["1-2", "4-5", "7-8"])
-    assert err.count("note: skipped topics of unsupported types: /noise") == 1
+    assert err.count("note: skipped topics of unsupported types: /noise") == 1 and "latency" not in err
     data = mcap_file(trace_messages())
     args = ["scenario", FIG1, "--online", "--window", "3", "--map", str(files / "map.parquet")]
     code, lines, _ = stdin_run(monkeypatch, capsys, data, args)
@@ -280,3 +281,11 @@ def test_a_bad_document_in_a_message_names_its_topic_and_log_time(monkeypatch, c
     messages = strem_messages()[:3] + [bad]
     code, lines, err = stdin_run(monkeypatch, capsys, mcap_file(messages), ["spre", "--online", "[[:car:]]"])
     assert code == 2 and lines == ["0-0", "1-1"] and err.startswith("scenegrep: error: /detections @ 300000000 ns")
+
+
+def test_latency_line_gives_median_and_p99_in_milliseconds():
+    latency = Latency(time.perf_counter, keep=True)
+    latency.frames.extend([0.004, 0.001, 0.003, 0.002])
+    latency.matches.append(0.0025)
+    assert latency.line() == ("latency: 4 frames, median 2.50 ms, p99 3.97 ms; 1 match, median 2.50 ms, p99 2.50 ms")
+    assert Latency(time.perf_counter, keep=False).line() == "latency: 0 frames; 0 matches"

@@ -17,6 +17,7 @@ and the same for each match alone. Median and 99th percentile in milliseconds.
 from __future__ import annotations
 
 import argparse
+from array import array
 import io
 import math
 import signal
@@ -59,14 +60,15 @@ def check_live_arguments(args: argparse.Namespace) -> None:
 
 
 class Latency:
-    """Latencies of frames and matches (seconds), measured around the iterators it wraps; ``found``:
-    whether any match was handed out."""
+    """Latencies of frames and matches (seconds), measured around the iterators it wraps when ``keep``
+    (8 bytes per frame and per match); ``found``: whether any match was handed out."""
 
-    def __init__(self, arrival: Callable[[], float]):
+    def __init__(self, arrival: Callable[[], float], keep: bool):
         self.arrival = arrival
+        self.keep = keep
         self.current = time.perf_counter()
-        self.frames: list[float] = []
-        self.matches: list[float] = []
+        self.frames = array("d")
+        self.matches = array("d")
         self.found = False
 
     def chunks(self, chunks: Iterable[Any]) -> Iterator[Any]:
@@ -74,21 +76,23 @@ class Latency:
         for chunk in chunks:
             self.current = self.arrival()
             yield chunk
-            self.frames.extend([time.perf_counter() - self.current] * chunk.n_frames)
+            if self.keep:
+                self.frames.extend([time.perf_counter() - self.current] * chunk.n_frames)
 
     def each_match(self, matches: Iterable[T]) -> Iterator[T]:
         """``matches``; each is timed when the next is asked for (after it was printed)."""
         for match in matches:
             self.found = True
             yield match
-            self.matches.append(time.perf_counter() - self.current)
+            if self.keep:
+                self.matches.append(time.perf_counter() - self.current)
 
     def line(self) -> str:
         """``latency: N frames, median X ms, p99 Y ms; M matches, median ..., p99 ...``."""
         return f"latency: {_stats(self.frames, 'frame', 'frames')}; {_stats(self.matches, 'match', 'matches')}"
 
 
-def _stats(times: list[float], one: str, many: str) -> str:
+def _stats(times: array, one: str, many: str) -> str:
     import numpy as np
 
     count = f"1 {one}" if len(times) == 1 else f"{len(times)} {many}"
@@ -138,7 +142,7 @@ def mcap_chunks(path: str, args: argparse.Namespace, stdin: BinaryIO | None = No
     from ..readers.mcap_follow import FollowOptions, follow_mcap
 
     messages = follow_mcap(path, FollowOptions(idle_timeout=args.idle_timeout), stdin)
-    latency = Latency(lambda: messages.arrival)
+    latency = Latency(lambda: messages.arrival, args.latency)
     name = "stdin" if path == "-" else Path(path).stem
     chunks = live_chunks(messages, name, TraceSource(messages.name, "ros-bag"), _note)
     return latency.chunks(chunks), latency

@@ -122,6 +122,6 @@ def _chunks(args: argparse.Namespace) -> tuple[Iterator[Any], Any]:
     is_mcap, stdin = standard_input()
     if is_mcap:
         return mcap_chunks("-", args, stdin)
-    latency = Latency(time.perf_counter)
+    latency = Latency(time.perf_counter, args.latency)
     lines = ((number, line) for number, line in enumerate(stdin, start=1) if line.strip())
     return latency.chunks(decode(line, f"<stdin>:{number}", "stdin") for number, line in lines), latency

@@ -176,7 +176,7 @@ def _run_live(query: Any, args: argparse.Namespace, options: Any) -> int:
         if is_mcap:
             chunks, latency = mcap_chunks("-", args, stdin)
         else:
-            latency = Latency(time.perf_counter)
+            latency = Latency(time.perf_counter, args.latency)
             chunks = latency.chunks(iter_documents(stdin))
     with until_stopped():
         _report(latency.each_match(search_stream(query, chunks, options)), args.follow or "", args, options)

@@ -1,25 +1,38 @@
-"""``following roadDirection from spot for D`` with ``spot`` a random point on a curb: exact regions
-of (s, D), a witness that reproduces the label, and answers that agree with a dense search.
+"""``following roadDirection from X for D`` with X random — a point on a curb, a point of a region
+(``intersection``), a vector of ranges — decided by inverting the walk: answers equal a brute-force
+reference wherever it is conclusive, and every witness, walked again, reproduces the label.
 
 The map is tests/scene/test_follow.py's (a straight lane, a bend, an exit lane whose centreline
-folds back, an intersection lane) with three curbs: one inside the straight lane, one across the
-bend, one along the exit lane over the fold. ``reference_walks`` is Scenic's
+folds back, an intersection lane across the exit) with three curbs: one inside the straight lane,
+one across the bend, one along the exit lane over the fold. ``reference_walks`` is Scenic's
 ``VectorField.followFrom`` written plainly, for many starts and distances at once.
+
+The reference samples X's domain (every 25 cm) and D (25 cm), walks every pair forward (once
+per module), and for the walks ending within 1 m of a label moves the start (along the curb, or
+by the miss) so that, if the heading sequence stays, the walk ends on the label; it walks those
+again. A walk that then reproduces the label (position and heading within the tolerance) is a
+conclusive yes; no sampled walk ending within 1 m of the label is taken as a conclusive no; in
+between the reference says nothing (only the witness check applies).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import re
+from functools import cache
 
 import numpy as np
 import pytest
+import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.scene import SceneOptions, Tolerance, compile_scene
+from scenegrep.scene.follow_inverse import preimages
 from scenegrep.scene.follow_regions import _distance_parts
 from scenegrep.scene.geometry import MapGeometry
+from scenegrep.scene.regions import MapRegion
 from tests.scene.frames import HEADER, trace_of
 from tests.scene.test_follow import ANYWHERE, FIELD, MAP
 
@@ -30,12 +43,19 @@ CURBS = (
 )
 CURB_MAP = dataclasses.replace(MAP, curbs=CURBS)
 GEOMETRY = MapGeometry(CURB_MAP)
-PROGRAM = (
-    "ego = new Car at 100 @ 0\nspot = new OrientedPoint on curb\n"
-    "c = new Car following roadDirection from spot for Range({lo}, {hi})"
-)
-RANGES = [(6.0, 20.0), (-20.0, -8.0), (15.0, 28.0)]
-"""Distance ranges tried: four steps either way, and a range across a change of step count."""
+BOX = (0.5, 3.0, 4.0, 30.0)
+"""x_lo, x_hi, y_lo, y_hi of the range-vector start (metres): the straight lane's first 30 m."""
+AREA = GEOMETRY.static_geometry(MapRegion("intersection"))
+"""The region ``intersection`` as scenegrep models it (the intersection area and lane)."""
+KINDS = {
+    "curb": ("spot = new OrientedPoint on curb\n", "spot", (-20.0, -8.0)),
+    "region": ("spot = new Point on intersection\n", "spot", (6.0, 20.0)),
+    "box": ("", f"Range({BOX[0]:g}, {BOX[1]:g}) @ Range({BOX[2]:g}, {BOX[3]:g})", (6.0, 20.0)),
+}
+"""Per start kind: the lines defining the start, the start expression, the distance range."""
+TOL = 1e-4
+NEAR_M = 1.0
+GRID_M = 0.25
 
 
 def reference_walks(x, y, distance):
@@ -54,52 +74,164 @@ def heading_at(x, y) -> np.ndarray:
     return GEOMETRY.scenic_headings(FIELD, np.atleast_1d(x), np.atleast_1d(y), None)
 
 
-def curb_point(curb: int, where: float) -> tuple[float, float]:
-    """The point a fraction ``where`` of the way along a curb polyline (by length)."""
-    line = CURBS[curb]
-    lengths = np.hypot(*np.diff(line, axis=0).T)
-    arc = where * lengths.sum()
-    k = min(int(np.searchsorted(np.cumsum(lengths), arc)), len(lengths) - 1)
-    t = (arc - np.concatenate([[0.0], np.cumsum(lengths)])[k]) / lengths[k]
-    x, y = line[k] + t * (line[k + 1] - line[k])
-    return float(x), float(y)
+def in_domain(kind: str, x: float, y: float) -> bool:
+    if kind == "curb":
+        return any(shapely.LineString(c).distance(shapely.Point(x, y)) <= 1e-6 for c in CURBS)
+    if kind == "region":
+        return bool(AREA.covers(shapely.Point(x, y)))
+    return BOX[0] <= x <= BOX[1] and BOX[2] <= y <= BOX[3]
 
 
-def match(lo: float, hi: float, label: tuple[float, float, float], tol: float):
+@cache
+def samples(kind: str):
+    """The reference's sampled starts (and, on a curb, its direction there) and distances, and
+    every pair's walk end (rows: start-major)."""
+    if kind == "curb":
+        parts = []
+        for line in CURBS:
+            for a, b in zip(line[:-1], line[1:]):
+                t = np.arange(0.0, 1.0, GRID_M / np.hypot(*(b - a)))
+                parts.append(
+                    np.column_stack([a + t[:, None] * (b - a), np.tile((b - a) / np.hypot(*(b - a)), (len(t), 1))])
+                )
+        starts = np.concatenate(parts)
+    elif kind == "region":
+        x0, y0, x1, y1 = AREA.bounds
+        gx, gy = np.meshgrid(np.arange(x0 + GRID_M / 2, x1, GRID_M), np.arange(y0 + GRID_M / 2, y1, GRID_M))
+        inside = shapely.covers(AREA, shapely.points(gx.ravel(), gy.ravel()))
+        starts = np.column_stack([gx.ravel()[inside], gy.ravel()[inside], np.zeros((inside.sum(), 2))])
+    else:
+        gx, gy = np.meshgrid(np.arange(BOX[0], BOX[1], GRID_M), np.arange(BOX[2], BOX[3], GRID_M))
+        starts = np.column_stack([gx.ravel(), gy.ravel(), np.zeros((gx.size, 2))])
+    lo, hi = KINDS[kind][2]
+    distances = np.arange(lo, hi + 1e-9, GRID_M)
+    x, y = np.repeat(starts[:, 0], len(distances)), np.repeat(starts[:, 1], len(distances))
+    d = np.tile(distances, len(starts))
+    ex, ey = reference_walks(x, y, d)
+    return np.repeat(starts, len(distances), axis=0), d, ex, ey
+
+
+def reference(kind: str, label: tuple[float, float, float]) -> bool | None:
+    """True when a start and distance reproduce the label (found as the module docstring says),
+    False when no sampled walk ends within :data:`NEAR_M` of it, else None."""
+    starts, d, ex, ey = samples(kind)
+    miss = np.stack([label[0] - ex, label[1] - ey], axis=1)
+    near = np.flatnonzero(np.max(np.abs(miss), axis=1) <= NEAR_M)
+    if not len(near):
+        return False
+    x, y, along, dist = starts[near, 0], starts[near, 1], starts[near, 2:], d[near].copy()
+    if kind == "curb":
+        # move s along the curb and D by delta: s e + delta a = miss, a the walk's mean direction
+        a = np.stack([ex[near] - x, ey[near] - y], axis=1) / dist[:, None]
+        det = along[:, 0] * a[:, 1] - along[:, 1] * a[:, 0]
+        ok = np.abs(det) > 1e-9
+        safe = np.where(ok, det, 1.0)
+        s = (miss[near, 0] * a[:, 1] - miss[near, 1] * a[:, 0]) / safe
+        delta = (along[:, 0] * miss[near, 1] - along[:, 1] * miss[near, 0]) / safe
+        # along the curb the walk's direction is the curb's: slide the start by the miss
+        s, delta = np.where(ok, s, np.einsum("ij,ij->i", miss[near], along)), np.where(ok, delta, 0.0)
+        x, y, dist = x + s * along[:, 0], y + s * along[:, 1], dist + delta
+        keep = np.ones(len(near), dtype=bool)
+    else:
+        x, y = x + miss[near, 0], y + miss[near, 1]
+        keep = np.ones(len(near), dtype=bool)
+    lo, hi = KINDS[kind][2]
+    keep &= (dist >= lo) & (dist <= hi)
+    keep &= np.array([in_domain(kind, a, b) for a, b in zip(x, y)], dtype=bool)
+    if not keep.any():
+        return None
+    wx, wy = reference_walks(x[keep], y[keep], dist[keep])
+    close = (np.abs(wx - label[0]) <= TOL) & (np.abs(wy - label[1]) <= TOL)
+    turn = np.abs(np.remainder(heading_at(wx, wy) - label[2] + math.pi, 2 * math.pi) - math.pi)
+    return True if np.any(close & (turn <= TOL)) else None
+
+
+@cache
+def query(kind: str):
+    lines, start, (lo, hi) = KINDS[kind]
+    program = (
+        f"ego = new Car at 100 @ 0\n{lines}c = new Car following roadDirection from {start} for Range({lo:g}, {hi:g})"
+    )
+    return compile_scene(HEADER + program, f"{kind}.scenic")
+
+
+def match(kind: str, label: tuple[float, float, float]):
     """Whether a car labeled at ``label`` matches, the solver verdicts, and the witness
-    (distance, start point) when it does."""
-    query = compile_scene(HEADER + PROGRAM.format(lo=lo, hi=hi), "start.scenic")
+    (distance, start x, start y) when it does."""
     trace = trace_of({"ego": ("Car", 100.0, 0.0, 0.0), "c": ("Car", *label)})
-    options = SceneOptions(Tolerance(tol, tol), correspondence={"c": "c"}, unknown_layers=ANYWHERE)
-    result = query.match(trace, CURB_MAP, options)
+    options = SceneOptions(Tolerance(TOL, TOL), correspondence={"c": "c"}, unknown_layers=ANYWHERE)
+    result = query(kind).match(trace, CURB_MAP, options)
     if not result.matched[0]:
         return False, result.matches.notes, None
     values = result.values(0)
-    distance = next(v for k, v in values.items() if k.startswith("Range"))
-    point = next(v for k, v in values.items() if "curb" in k)
-    return True, result.matches.notes, (distance, point)
+    lo, hi = KINDS[kind][2]
+    distance = next(v for k, v in values.items() if k.startswith(f"Range({lo:g}, {hi:g})"))
+    if kind == "box":
+        x = next(v for k, v in values.items() if k.startswith(f"Range({BOX[0]:g},"))
+        y = next(v for k, v in values.items() if k.startswith(f"Range({BOX[2]:g},"))
+    else:
+        x, y = next(v for k, v in values.items() if re.match(r"point (on|in)", k))
+    return True, result.matches.notes, (distance, x, y)
 
 
-def dense_search(lo: float, hi: float, label, tol: float) -> bool:
-    """Whether some start on a grid along every curb (at most 5 cm apart; those within reach of the
-    label) and distance (2 cm) reproduces the label."""
-    starts = np.array([curb_point(c, w) for c in range(len(CURBS)) for w in np.linspace(0, 1, 600)])
-    reach = np.hypot(starts[:, 0] - label[0], starts[:, 1] - label[1]) <= max(-lo, hi) + 2 * tol
-    starts = starts[reach]
-    distances = np.linspace(lo, hi, int(round((hi - lo) / 0.02)) + 1)
-    x, y = np.repeat(starts[:, 0], len(distances)), np.repeat(starts[:, 1], len(distances))
-    ex, ey = reference_walks(x, y, np.tile(distances, len(starts)))
-    close = (np.abs(ex - label[0]) <= tol) & (np.abs(ey - label[1]) <= tol)
-    if not close.any():
-        return False
-    turn = np.abs(np.remainder(heading_at(ex[close], ey[close]) - label[2] + math.pi, 2 * math.pi) - math.pi)
-    return bool(np.any(turn <= tol))
+def planted(kind: str, index: float, dx: float, dy: float, turn: float) -> tuple[float, float, float]:
+    """The end of a sampled walk (``index`` a fraction of the samples), moved and turned."""
+    starts, d, ex, ey = samples(kind)
+    k = min(int(index * len(d)), len(d) - 1)
+    return float(ex[k] + dx), float(ey[k] + dy), float(heading_at(ex[k] + dx, ey[k] + dy)[0] + turn)
 
 
-def reproduces(witness, label, tol: float) -> bool:
-    distance, (x, y) = witness
+def check(kind: str, label: tuple[float, float, float]) -> None:
+    """The decision agrees with the reference where it is conclusive, was taken by the inverted
+    walk, and a match's witness, walked again, reproduces the label from X's domain."""
+    found, notes, witness = match(kind, label)
+    assert notes["follow-start:sat"] + notes["follow-start:unsat"] == 1, notes
+    if found:
+        distance, x, y = witness
+        lo, hi = KINDS[kind][2]
+        assert lo <= distance <= hi and in_domain(kind, x, y)
+        ex, ey = reference_walks(x, y, distance)
+        assert max(abs(ex[0] - label[0]), abs(ey[0] - label[1])) <= TOL + 1e-9
+    expected = reference(kind, label)
+    if expected is not None:
+        assert found == expected
+
+
+OFFSETS = st.sampled_from([0.0, 0.0, 0.05, -0.3, 1.5, 3.0])
+
+
+@settings(max_examples=20, deadline=None, derandomize=True)
+@given(st.sampled_from(sorted(KINDS)), st.floats(0.0, 1.0), OFFSETS, OFFSETS, st.sampled_from([0.0, 0.0, 0.3]))
+def test_random_start_answers_agree_with_a_brute_force_reference(kind, index, dx, dy, turn):
+    check(kind, planted(kind, index, dx, dy, turn))
+
+
+@pytest.mark.parametrize("kind", sorted(KINDS))
+def test_planted_walks_match_with_witnesses_and_far_labels_do_not(kind):
+    """Three planted walks per kind match (the reference agrees); a label 80 m east of one, beyond
+    every walk's reach from the domain, is refuted by the inverted walk itself."""
+    for index in (0.2, 0.5, 0.8):
+        label = planted(kind, index, 0.0, 0.0, 0.0)
+        assert reference(kind, label) is True
+        check(kind, label)
+    far = planted(kind, 0.5, 80.0, 0.0, 0.0)
+    assert reference(kind, far) is False
+    found, notes, _ = match(kind, far)
+    assert not found and notes["follow-start:unsat"] == 1
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(st.floats(0.0, 1.0), st.floats(0.0, 1.0), st.floats(-20.0, 28.0))
+def test_the_preimage_holds_every_walk_ending_at_its_point(where_x, where_y, distance):
+    """Walk forward from a point of the lanes: the preimage of the end holds that start and
+    distance."""
+    x0, y0, x1, y1 = shapely.union_all(MAP.lane_polygons).bounds
+    x, y = x0 + where_x * (x1 - x0), y0 + where_y * (y1 - y0)
     ex, ey = reference_walks(x, y, distance)
-    return max(abs(ex[0] - label[0]), abs(ey[0] - label[1])) <= tol + 1e-9
+    pre = preimages(GEOMETRY, FIELD, ex, ey, np.array([min(distance, -20.0)]), np.array([max(distance, 28.0)]))
+    inside = (pre.lo <= distance + 1e-9) & (pre.hi >= distance - 1e-9)
+    starts = np.hypot(ex[0] + distance * pre.ax[inside] - x, ey[0] + distance * pre.ay[inside] - y)
+    assert np.any(starts <= 1e-6)
 
 
 def test_distance_parts_cut_at_step_counts_and_zero():
@@ -108,71 +240,12 @@ def test_distance_parts_cut_at_step_counts_and_zero():
     assert _distance_parts(-5.0, 27.0) == [(4, -5.0, 0.0), (4, 0.0, 20.0), (5, 20.0, 25.0), (6, 25.0, 27.0)]
 
 
-@settings(max_examples=30, deadline=None, derandomize=True)
-@given(st.integers(0, len(CURBS) - 1), st.floats(0.0, 1.0), st.sampled_from(RANGES), st.floats(0.0, 1.0))
-def test_a_planted_walk_from_a_curb_matches_with_a_witness_that_reproduces_it(curb, where, span, share):
-    lo, hi = span
-    x, y = curb_point(curb, where)
-    ex, ey = reference_walks(x, y, lo + share * (hi - lo))
-    label = (float(ex[0]), float(ey[0]), float(heading_at(ex, ey)[0]))
-    found, notes, witness = match(lo, hi, label, 1e-4)
-    assert found
-    if notes["follow-start:sat"]:
-        assert reproduces(witness, label, 1e-4)
-        assert lo <= witness[0] <= hi
-
-
-@settings(max_examples=3, deadline=None, derandomize=True)
-@given(
-    st.integers(0, len(CURBS) - 1),
-    st.floats(0.0, 1.0),
-    st.sampled_from(RANGES[:2]),
-    st.floats(0.0, 1.0),
-    st.floats(-0.3, 0.3),
-    st.floats(-0.3, 0.3),
-)
-def test_random_start_answers_agree_with_a_dense_search(curb, where, span, share, dx, dy):
-    """A perturbed label: a match decided here has a reproducing witness (no false match), and a
-    dense search finding a reproducing start and distance means a match (no false miss)."""
-    lo, hi = span
-    x, y = curb_point(curb, where)
-    ex, ey = reference_walks(x, y, lo + share * (hi - lo))
-    label = (float(ex[0]) + dx, float(ey[0]) + dy, float(heading_at(ex, ey)[0]))
-    tol = 0.05
-    found, notes, witness = match(lo, hi, label, tol)
-    if found and notes["follow-start:sat"]:
-        assert reproduces(witness, label, tol)
-    if dense_search(lo, hi, label, tol):
-        assert found
-    if not found:
-        assert notes["follow-start:unsat"]
-
-
-def test_labels_no_start_can_produce_do_not_match():
-    """Turned by 0.3 rad, or moved 3 m across the road direction: no start and distance reproduce
-    the label (the dense search agrees), and the query says so itself, without the general solvers."""
-    lo, hi = RANGES[0]
-    x, y = curb_point(0, 0.4)
-    ex, ey = reference_walks(x, y, 12.0)
-    heading = float(heading_at(ex, ey)[0])
-    assert match(lo, hi, (float(ex[0]), float(ey[0]), heading), 1e-4)[0]
-    across = (-math.cos(heading), -math.sin(heading))
-    for label in (
-        (float(ex[0]), float(ey[0]), heading + 0.3),
-        (float(ex[0]) + 3 * across[0], float(ey[0]) + 3 * across[1], heading),
-    ):
-        assert not dense_search(lo, hi, label, 1e-4)
-        assert not match(lo, hi, label, 1e-4)[0]
-    moved = (float(ex[0]) + 3 * across[0], float(ey[0]) + 3 * across[1], heading)
-    assert match(lo, hi, moved, 1e-4)[1]["follow-start:unsat"] == 1
-
-
 @pytest.mark.slow
 @pytest.mark.real_data
 def test_scenic_samples_from_town01_curbs_match_with_witnesses_and_perturbations_do_not(maps_dir):
     """Scenic 3.1.1's own scenes of examples/scenes/following_curb.scenic: each matches through
-    this path with a witness whose walk (Scenic's rule) ends at the label; moved 3 m across its
-    heading or turned by 0.3 rad, none matches (the moved ones refuted here, exactly)."""
+    the inverted walk with a witness whose walk (Scenic's rule) ends at the label; moved 3 m across
+    its heading (refuted by the inverted walk) or turned by 0.3 rad, none matches."""
     from pathlib import Path
 
     from scenegrep.readers.opendrive import read_map
@@ -184,12 +257,12 @@ def test_scenic_samples_from_town01_curbs_match_with_witnesses_and_perturbations
 
     program = Path(__file__).resolve().parents[2] / "examples" / "scenes" / "following_curb.scenic"
     town = maps_dir / "Town01.xodr"
-    trace = sample_scenes(program, 12, map_path=town, seed=5)  # benchmarks/bench_follow.py --random-start: 30
+    trace = sample_scenes(program, 12, map_path=town, seed=5)  # benchmarks/bench_follow.py: 30
     road_map = read_map(town)
     geometry = geometry_of(road_map)
-    query = load_scene(program)
+    scene = load_scene(program)
     options = SceneOptions(Tolerance(), correspondence={"ego": "ego", "otherCar": "obj1"})
-    result = query.match(trace, road_map, options)
+    result = scene.match(trace, road_map, options)
     assert result.matched.all()
     assert result.matches.notes["follow-start:sat"] == trace.n_frames
     car = trace.states.object == trace.object_index("obj1")
@@ -200,8 +273,8 @@ def test_scenic_samples_from_town01_curbs_match_with_witnesses_and_perturbations
         end_x, end_y = walk_end(geometry, FIELD, [x], [y], [distance], None)
         row = np.flatnonzero(car & (trace.states.frame == frame))[0]
         assert abs(end_x[0] - trace.states.x[row]) <= 1e-6 and abs(end_y[0] - trace.states.y[row]) <= 1e-6
-    moved = query.match(perturbed(trace, "obj1", "lateral", 3.0), road_map, options)
+    moved = scene.match(perturbed(trace, "obj1", "lateral", 3.0), road_map, options)
     assert not moved.matched.any()
     assert moved.matches.notes["follow-start:unsat"] == trace.n_frames
-    turned = query.match(perturbed(trace, "obj1", "heading", 0.3), road_map, options)
+    turned = scene.match(perturbed(trace, "obj1", "heading", 0.3), road_map, options)
     assert not turned.matched.any()

@@ -68,13 +68,19 @@ TURN_RAD = np.pi / 2
 turns by more than this between them (folds where pieces of a lane join, sharp bends); elsewhere
 the nearest segment changes at a vertex line."""
 
+ONLY_RAD = 1e-6
+"""With a heading to cut for (:func:`crossings`), pairs of segments whose headings are farther
+from it than this (radians) are not looked at."""
+
 SLACK = 1e-9
 """Slack on a foot-of-perpendicular parameter when checking which distance piece holds."""
 
 
 @dataclass
 class Linework:
-    """Where ``roadDirection`` may change (see the module docstring): segments with an R-tree, and
+    """Where ``roadDirection`` may change (see the module docstring): segments with an R-tree (and,
+    for the lines at a centreline's vertex, the headings of the segments either side, between
+    which alone the heading may change there; NaN for area boundaries), and
     pairs of non-adjacent centreline segments of one lane that may compete for a point, with an
     R-tree of the boxes where they may (within the lane's reach of both); the centreline segments
     as lines; an R-tree of where a lane's direction may count at all (each lane grown by Scenic's
@@ -82,6 +88,7 @@ class Linework:
 
     start: np.ndarray
     end: np.ndarray
+    side: np.ndarray
     tree: shapely.STRtree
     pairs: np.ndarray
     pair_lane: np.ndarray
@@ -128,31 +135,34 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     areas = list(road_map.lane_polygons) + intersections + shoulders
     bands = [list(road_map.lane_polygons), intersections, shoulders]
     areas += [shapely.buffer(shapely.union_all(band), ELEMENT_REACH_M) for band in bands if band]
-    starts, ends = [np.zeros((0, 2))], [np.zeros((0, 2))]
+    starts, ends, sides = [np.zeros((0, 2))], [np.zeros((0, 2))], [np.zeros((0, 2))]
     for ring in shapely.get_rings(shapely.get_parts(np.array(areas, dtype=object))):
         coords = shapely.get_coordinates(ring)
         starts.append(coords[:-1])
         ends.append(coords[1:])
+        sides.append(np.full((len(coords) - 1, 2), np.nan))
     polylines = road_map.centreline_polylines
     reach = shapely.hausdorff_distance(shapely.boundary(road_map.lane_polygons), polylines.geometries)
-    lines = list(zip(polylines.lines, (reach + REACH_MARGIN_M).tolist()))
+    lines = [(polylines, k, r) for k, r in enumerate((reach + REACH_MARGIN_M).tolist())]
     if all(a.centreline is not None for a in road_map.shoulders):
         centres = Polylines([a.centreline for a in road_map.shoulders])
         near = shapely.hausdorff_distance(shapely.boundary(np.array(shoulders, dtype=object)), centres.geometries)
-        lines += list(zip(centres.lines, (near + REACH_MARGIN_M).tolist()))
-    for line, length in lines:
-        vertex_starts, vertex_ends = _vertex_lines(line, length)
+        lines += [(centres, k, r) for k, r in enumerate((near + REACH_MARGIN_M).tolist())]
+    for owner, k, length in lines:
+        vertex_starts, vertex_ends = _vertex_lines(owner.lines[k], length)
         starts.append(vertex_starts)
         ends.append(vertex_ends)
-    start, end = np.concatenate(starts), np.concatenate(ends)
+        heading = owner.heading[owner.first[k] : owner.first[k] + owner.count[k]]
+        sides.append(np.tile(np.stack([heading[:-1], heading[1:]], axis=1), (3, 1)))
+    start, end, side = np.concatenate(starts), np.concatenate(ends), np.concatenate(sides)
     keep = np.any(start != end, axis=1)
-    start, end = start[keep], end[keep]
+    start, end, side = start[keep], end[keep], side[keep]
     tree = shapely.STRtree(shapely.linestrings(np.stack([start, end], axis=1)))
     pairs, lanes, boxes = _competing_pairs(polylines, reach)
     near = reach[lanes] + REACH_MARGIN_M
     segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
     lane_reach = shapely.STRtree(np.append(shapely.buffer(road_map.lane_polygons, ELEMENT_REACH_M), intersections))
-    return Linework(start, end, tree, pairs, lanes, near, shapely.STRtree(boxes), polylines, segments, lane_reach)
+    return Linework(start, end, side, tree, pairs, lanes, near, shapely.STRtree(boxes), polylines, segments, lane_reach)
 
 
 def _competing_pairs(polylines: Polylines, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -194,10 +204,11 @@ def _vertex_lines(vertices: np.ndarray, length: float) -> tuple[np.ndarray, np.n
     return centre - length * lines, centre + length * lines
 
 
-def crossings(lw: Linework, px, py, qx, qy) -> tuple[np.ndarray, np.ndarray]:
+def crossings(lw: Linework, px, py, qx, qy, only=None) -> tuple[np.ndarray, np.ndarray]:
     """(segment index, parameter t in (0, 1)) where segment i from p_i to q_i crosses the linework
     (for a stretch of linework along the segment, both ends of the overlap), or where two
-    competing centreline segments become equally near along it."""
+    competing centreline segments become equally near along it (with ``only``, a heading per
+    segment: only pairs one of whose segments has that heading, the changes to or from it)."""
     moving = np.hypot(qx - px, qy - py) > DEGENERATE_M
     index = np.flatnonzero(moving)
     if not len(index):
@@ -206,8 +217,13 @@ def crossings(lw: Linework, px, py, qx, qy) -> tuple[np.ndarray, np.ndarray]:
     r = np.stack([qx, qy], 1)[index] - p
     segments = shapely.linestrings(np.stack([p, p + r], axis=1))
     walk, line = lw.tree.query(segments)
+    if only is not None:
+        side = lw.side[line]
+        near = np.abs(_wrap(side - np.asarray(only)[index][walk][:, None])) <= ONLY_RAD
+        mine = np.isnan(side[:, 0]) | np.any(near, axis=1)
+        walk, line = walk[mine], line[mine]
     found_walk, found_t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
-    tie_walk, tie_t, _ = _ties(lw, p, r, segments)
+    tie_walk, tie_t, _ = _ties(lw, p, r, segments, None if only is None else np.asarray(only)[index])
     found_walk = np.concatenate([walk[found_walk], tie_walk])
     found_t = np.concatenate([found_t, tie_t])
     inside = (found_t > 0) & (found_t < 1)
@@ -228,10 +244,14 @@ def ties(lw: Linework, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, 
     return np.concatenate([walk, walk]), np.concatenate([lw.pairs[pair, 0], lw.pairs[pair, 1]])
 
 
-def _ties(lw: Linework, p: np.ndarray, r: np.ndarray, segments: np.ndarray):
+def _ties(lw: Linework, p: np.ndarray, r: np.ndarray, segments: np.ndarray, only=None):
     """(segment index, t, pair index) where the two segments of a competing pair are equally near
-    p + t r."""
+    p + t r (with ``only``: pairs one of whose segments has heading ``only[segment index]``)."""
     walk, pair = lw.pair_tree.query(segments)
+    if only is not None:
+        heading = lw.polylines.heading[lw.pairs[pair]]
+        mine = np.any(np.abs(_wrap(heading - only[walk][:, None])) <= ONLY_RAD, axis=1)
+        walk, pair = walk[mine], pair[mine]
     for side in (0, 1):
         near = shapely.dwithin(segments[walk], lw.segments[lw.pairs[pair, side]], lw.pair_reach[pair])
         walk, pair = walk[near], pair[near]
@@ -394,12 +414,13 @@ def _by_step_count(lo: np.ndarray, hi: np.ndarray) -> _Branches:
     return _Branches(row, low, high, steps, zeros, zeros.copy())
 
 
-def _split(lw: Linework, x, y, b: _Branches) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _split(lw: Linework, x, y, b: _Branches, only=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cut each branch's D interval where its current point crosses the linework:
-    (branch index, lo, hi) of the sub-intervals, in branch then D order."""
+    (branch index, lo, hi) of the sub-intervals, in branch then D order (``only`` as in
+    :func:`crossings`)."""
     px, py = x[b.row] + b.lo * b.ax, y[b.row] + b.lo * b.ay
     qx, qy = x[b.row] + b.hi * b.ax, y[b.row] + b.hi * b.ay
-    walk, t = crossings(lw, px, py, qx, qy)
+    walk, t = crossings(lw, px, py, qx, qy, only)
     n = len(b.row)
     owner = np.concatenate([np.arange(n), np.arange(n), walk])
     cut = np.concatenate([np.zeros(n), np.ones(n), t])

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 
 import numpy as np
+import shapely
 
 from ..decide import Tolerance
 from ..dependencies import Group
@@ -38,8 +39,10 @@ from . import linear, smt
 from .branch_prune import BranchAndPrune, Outcome
 from .pointwise import satisfies
 from .problem import Bound, PointUnknown, Problem, build
+from ..follow_inverse import Preimage
 from ..follow_pieces import Pieces
 from .walk import Walk, find_walk, solve_walk, walk_pieces
+from .walk_inverse import StartWalk, find_start_walk, solve_start_walk, start_preimages
 from .walk_start import find_curb_walk, solve_curb_walk
 
 
@@ -50,8 +53,11 @@ def decide_rows(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray
     problems = [build(ev, group, tolerance, row) for row in range(ev.size)]
     walks = [find_walk(problem) if problem.unknowns else None for problem in problems]
     pieces = walk_pieces(problems, walks, ev.geometry)
+    starts = [find_start_walk(p) if p.unknowns and w is None else None for p, w in zip(problems, walks)]
+    inverted = start_preimages(problems, starts, ev.geometry)
     for row, problem in enumerate(problems):
-        outcome = solve(problem, ev.geometry, tolerance, walks[row], pieces.get(row))
+        start = (starts[row], *inverted[row]) if row in inverted else None
+        outcome = solve(problem, ev.geometry, tolerance, walks[row], pieces.get(row), start)
         ev.notes[f"{outcome.solver}:{outcome.status}"] += 1
         ok[row] = outcome.feasible
     return ok
@@ -63,9 +69,11 @@ def solve(
     tolerance: Tolerance,
     walk: Walk | None = None,
     pieces: Pieces | None = None,
+    start: tuple[StartWalk, Preimage, shapely.Geometry] | None = None,
 ) -> Outcome:
     """Decide one specialised system (see the module docstring); ``walk`` and ``pieces`` are the
-    row's walk and its pieces when already found."""
+    row's walk and its pieces when already found, ``start`` its random-start walk, preimage and
+    start domain (:func:`.walk_inverse.start_preimages`)."""
     if not problem.unknowns:
         return Outcome("sat", {}, "direct") if satisfies(problem, geometry, {}) else Outcome("unsat", None, "direct")
     delta = max(tolerance.position, tolerance.heading)
@@ -73,6 +81,14 @@ def solve(
     if walk is not None:
         pieces = pieces or walk_pieces([problem], [walk], geometry)[0]
         return solve_walk(problem, walk, pieces, lambda piece, boxes: _solve_piece(piece, geometry, boxes, delta))
+    if start is None:
+        found = find_start_walk(problem)
+        inverted = start_preimages([problem], [found], geometry) if found is not None else {}
+        start = (found, *inverted[0]) if 0 in inverted else None  # type: ignore[assignment]
+    if start is not None:
+        outcome = solve_start_walk(problem, start[0], geometry, start[1], start[2])
+        if outcome.status != "undecided":
+            return outcome
     curb_walk = find_curb_walk(problem)
     if curb_walk is not None:
         outcome = solve_curb_walk(problem, curb_walk, geometry)

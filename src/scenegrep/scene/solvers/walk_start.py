@@ -120,8 +120,8 @@ def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> 
         segment = region.segment
         witness = _checked_witness(problem, walk, geometry, start[segment], end[segment], region)
         if witness is not None:
-            return Outcome("sat", witness, "follow-start")
-    return Outcome("undecided" if candidates else "unsat", None, "follow-start")
+            return Outcome("sat", witness, "follow-regions")
+    return Outcome("undecided" if candidates else "unsat", None, "follow-regions")
 
 
 def _pieces(start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

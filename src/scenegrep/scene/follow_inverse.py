@@ -1,0 +1,381 @@
+"""The walk ``follow roadDirection from X for D`` inverted: every start X and distance D whose walk
+ends at a given point E (the preimage of E), for D in an interval.
+
+Scenic's walk (:mod:`.follow`) takes ``n = max(4, ceil(D / 5))`` steps of ``D / n`` metres, step k
+along the field's heading h_k at the point p_k reached so far: ``p_{k+1} = p_k + (D / n) u(h_k)``,
+``u(h) = (-sin h, cos h)`` (radians, 0 = +y). Read backwards from ``p_n = E``, each earlier point is
+``p_k = p_{k+1} - (D / n) u(h_k)`` for a heading h_k that the field must take *at p_k itself*; the
+field takes finitely many values near p_{k+1} (the headings of the centreline segments of lanes and
+shoulders within reach, and 0), so each is tried: with the headings h_k .. h_{n-1} chosen, p_k is
+``E + D b_k`` with ``b_k = -(1/n) sum_{j>=k} u(h_j)``, affine in D, and it sweeps a segment as D
+runs over an interval. Cutting that segment where it crosses the linework of
+:mod:`.follow_pieces` gives sub-intervals of D on which the field at p_k is one heading (read at
+their midpoints, the assumption :mod:`.follow_pieces` makes); those on which it is h_k are kept.
+After n steps backwards the start is ``X = E + D b_0``: the preimage is a set of segments of the
+plane (one per heading sequence and D sub-interval), usually a handful.
+
+A candidate heading h_k comes from a segment of a centreline (a lane's, or a shoulder's) within
+:attr:`Inverse.reach` of p_k: Scenic reads a point's heading off the nearest segment of the
+centreline of the lane or shoulder holding it (or, in an intersection area or within 5 cm of a
+lane, of the nearest one), which lies within the lane's reach of the point (the farthest point of
+the lane from its centreline) plus the widest gap of an intersection area outside its lanes. A
+candidate is also dropped when p_k's segment stays farther than that from every segment with its
+heading (no point of that segment can take it).
+
+With ``check_first=False`` the first heading h_0 is not checked against the field along X's
+segment: the caller checks it at the start it picks (a start on a curb lies on the linework, where
+the heading read inside a sub-interval need not be the one at the start itself).
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+
+from ..model.polylines import Polylines
+from .follow_pieces import DEGENERATE_M, _by_step_count, _Columns, _split, linework
+from .geometry import ELEMENT_REACH_M, MapGeometry
+from .regions import Field
+
+REACH_MARGIN_M = 0.25
+"""Added to the farthest distance at which a centreline segment may give a point its heading."""
+
+
+DOMAIN_SLACK_M = 1e-6
+"""Slack on the reach of a branch's remaining steps towards the start's domain (metres)."""
+
+
+@dataclass
+class Inverse:
+    """Per map: every centreline segment (lanes, then shoulders): an R-tree of the boxes within
+    its reach, its heading (radians), its ends (rows of x0, y0, x1, y1) and its reach (metres:
+    no point farther from it takes its heading); and the union of the lanes, intersection areas
+    and shoulders (off which a point may take heading 0)."""
+
+    tree: shapely.STRtree
+    heading: np.ndarray
+    ends: np.ndarray
+    reach: np.ndarray
+    roads: shapely.Geometry
+
+
+@dataclass
+class Preimage(_Columns):
+    """Walks ending at E[row]: for every D in [lo, hi] the start ``X = E + D (ax, ay)`` walks to E
+    in ``steps`` steps; ``first`` is the first step's heading when it is still to be checked at X
+    (NaN when it was checked along the segment)."""
+
+    row: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    steps: np.ndarray
+    ax: np.ndarray
+    ay: np.ndarray
+    first: np.ndarray
+
+
+@dataclass
+class _Back(_Columns):
+    """Walks under backward enumeration: the point reached so far is ``E[row] + D (ax, ay)`` for D
+    in [lo, hi], ``left`` steps before it still to choose, ``first`` as in :class:`Preimage`."""
+
+    row: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    steps: np.ndarray
+    ax: np.ndarray
+    ay: np.ndarray
+    left: np.ndarray
+    first: np.ndarray
+
+
+def inverse(geometry: MapGeometry) -> Inverse:
+    """The map's centreline segments for candidate headings, built once per geometry."""
+    found = _INVERSE.get(geometry)
+    if found is None:
+        found = _INVERSE[geometry] = _build_inverse(geometry)
+    return found
+
+
+def _build_inverse(geometry: MapGeometry) -> Inverse:
+    road_map = geometry._require_map()
+    lines = road_map.centreline_polylines
+    owner = np.repeat(np.arange(len(lines)), lines.count)
+    lane_reach = _reach(road_map.lane_polygons, lines)[owner]
+    reach = lane_reach + ELEMENT_REACH_M
+    lanes = shapely.union_all(road_map.lane_polygons) if len(road_map.lanes) else shapely.Polygon()
+    index = road_map.lane_index
+    for area in road_map.intersections:
+        outside = shapely.difference(area.polygon, lanes)
+        if outside.is_empty:
+            continue
+        coords = shapely.get_coordinates(shapely.segmentize(outside, 0.25))
+        gap = float(np.max(shapely.distance(shapely.points(coords), lanes), initial=0.0)) + 0.25
+        inside = np.isin(owner, [index[lane] for lane in area.lanes if lane in index])
+        reach[inside] = np.maximum(reach[inside], lane_reach[inside] + gap)
+    centres, reaches = [lines], [reach]
+    if road_map.shoulders and all(a.centreline is not None for a in road_map.shoulders):
+        shoulders = Polylines([a.centreline for a in road_map.shoulders])
+        areas = np.array([a.polygon for a in road_map.shoulders], dtype=object)
+        owner = np.repeat(np.arange(len(shoulders)), shoulders.count)
+        centres.append(shoulders)
+        reaches.append(_reach(areas, shoulders)[owner] + ELEMENT_REACH_M)
+    start = np.concatenate([c.start for c in centres])
+    end = np.concatenate([c.end for c in centres])
+    heading = np.concatenate([c.heading for c in centres])
+    reach = np.concatenate(reaches) + REACH_MARGIN_M
+    low, high = np.minimum(start, end) - reach[:, None], np.maximum(start, end) + reach[:, None]
+    near = shapely.box(low[:, 0], low[:, 1], high[:, 0], high[:, 1])
+    areas = [lanes] + [a.polygon for a in road_map.intersections] + [a.polygon for a in road_map.shoulders]
+    roads = shapely.union_all(areas)
+    shapely.prepare(roads)
+    return Inverse(shapely.STRtree(near), heading, np.concatenate([start, end], axis=1), reach, roads)
+
+
+def _reach(polygons: np.ndarray, lines: Polylines) -> np.ndarray:
+    """How far each polygon's farthest point lies from its centreline (metres, boundaries densified)."""
+    return shapely.hausdorff_distance(shapely.boundary(polygons), lines.geometries, densify=0.1)
+
+
+def preimages(
+    geometry: MapGeometry,
+    field: Field,
+    ex: np.ndarray,
+    ey: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    check_first: bool = True,
+    domain: np.ndarray | None = None,
+) -> Preimage:
+    """The preimage (see the module docstring) of each point (ex[i], ey[i]) for D in [lo[i], hi[i]]
+    (metres, finite, lo <= hi). With ``domain`` (a shapely geometry per point: where the start
+    must lie), only the walks that may start there: a branch whose point is farther from the
+    domain than its remaining steps can go (each ``|D| / n`` long) is dropped."""
+    lw, inv = linework(geometry), inverse(geometry)
+    ex, ey = np.asarray(ex, dtype=float), np.asarray(ey, dtype=float)
+    start = _by_step_count(np.asarray(lo, dtype=float), np.asarray(hi, dtype=float))
+    n = len(start.row)
+    b = _Back(start.row, start.lo, start.hi, start.steps, start.ax, start.ay, start.steps.copy(), np.full(n, np.nan))
+    done = []
+    while len(b.row):
+        last = b.left == 1
+        moved = _candidates(inv, ex, ey, b)
+        if domain is not None:
+            moved = moved.take(np.flatnonzero(_may_start(ex, ey, moved.branches, domain)))
+            if check_first:
+                moved = _clipped(ex, ey, moved, domain)
+        if check_first:
+            moved = _consistent(geometry, field, lw, ex, ey, moved)
+        else:
+            keep = moved.take(np.flatnonzero(~last[moved.parent]))
+            first = moved.take(np.flatnonzero(last[moved.parent]))
+            done.append(first.branches)
+            moved = _consistent(geometry, field, lw, ex, ey, keep)
+        finished = moved.left == 0
+        done.append(moved.branches.take(np.flatnonzero(finished)))
+        b = moved.branches.take(np.flatnonzero(~finished))
+    found = _concat(done) if done else b
+    return Preimage(found.row, found.lo, found.hi, found.steps, found.ax, found.ay, found.first)
+
+
+@dataclass
+class _Moved:
+    """Branches one step further back, each with its heading and the index of its parent branch."""
+
+    branches: _Back
+    heading: np.ndarray
+    parent: np.ndarray
+
+    @property
+    def left(self) -> np.ndarray:
+        return self.branches.left
+
+    def take(self, index: np.ndarray) -> _Moved:
+        return _Moved(self.branches.take(index), self.heading[index], self.parent[index])
+
+
+def _may_start(ex, ey, b: _Back, domain: np.ndarray) -> np.ndarray:
+    """Whether each branch's point, swept over its D interval, lies within its remaining steps of
+    its row's domain."""
+    p = np.stack([ex[b.row] + b.lo * b.ax, ey[b.row] + b.lo * b.ay], axis=1)
+    q = np.stack([ex[b.row] + b.hi * b.ax, ey[b.row] + b.hi * b.ay], axis=1)
+    reach = b.left * np.maximum(np.abs(b.lo), np.abs(b.hi)) / b.steps + DOMAIN_SLACK_M
+    return shapely.dwithin(shapely.linestrings(np.stack([p, q], axis=1)), domain[b.row], reach)
+
+
+def _clipped(ex, ey, moved: _Moved, domain: np.ndarray) -> _Moved:
+    """The branches with no step left, their D intervals narrowed to the hull of the D whose start
+    lies in the domain (those with none dropped)."""
+    b = moved.branches
+    last = np.flatnonzero(b.left == 0)
+    if not len(last):
+        return moved
+    p = np.stack([ex[b.row[last]] + b.lo[last] * b.ax[last], ey[b.row[last]] + b.lo[last] * b.ay[last]], axis=1)
+    q = np.stack([ex[b.row[last]] + b.hi[last] * b.ax[last], ey[b.row[last]] + b.hi[last] * b.ay[last]], axis=1)
+    r = q - p
+    rr = np.einsum("ij,ij->i", r, r)
+    inside = shapely.intersection(shapely.linestrings(np.stack([p, q], axis=1)), domain[b.row[last]])
+    coords, owner = shapely.get_coordinates(inside, return_index=True)
+    t = np.einsum("ij,ij->i", coords - p[owner], r[owner]) / np.maximum(rr[owner], 1e-300)
+    t_lo, t_hi = np.full(len(last), np.inf), np.full(len(last), -np.inf)
+    np.minimum.at(t_lo, owner, t)
+    np.maximum.at(t_hi, owner, t)
+    still = rr <= DEGENERATE_M**2
+    t_lo, t_hi = np.where(still & (t_lo <= t_hi), 0.0, np.clip(t_lo, 0, 1)), np.where(still, 1.0, np.clip(t_hi, 0, 1))
+    width = b.hi[last] - b.lo[last]
+    b.lo[last], b.hi[last] = b.lo[last] + t_lo * width, b.lo[last] + t_hi * width
+    keep = np.ones(len(b.row), dtype=bool)
+    keep[last] = np.isfinite(t_lo) & (t_lo <= t_hi)
+    return moved.take(np.flatnonzero(keep))
+
+
+def _candidates(inv: Inverse, ex, ey, b: _Back) -> _Moved:
+    """Each branch one step back along every heading a centreline segment near it has, its D
+    interval narrowed to where the new point stays within the segment's reach (the hull over the
+    segments sharing a heading), and along heading 0 where the new point may leave the road."""
+    px, qx = ex[b.row] + b.lo * b.ax, ex[b.row] + b.hi * b.ax
+    py, qy = ey[b.row] + b.lo * b.ay, ey[b.row] + b.hi * b.ay
+    grow = np.maximum(np.abs(b.lo), np.abs(b.hi)) / b.steps
+    boxes = shapely.box(
+        np.minimum(px, qx) - grow, np.minimum(py, qy) - grow, np.maximum(px, qx) + grow, np.maximum(py, qy) + grow
+    )
+    branch, segment = inv.tree.query(boxes)
+    heading = inv.heading[segment]
+    lo, hi = _within(ex, ey, b, branch, heading, (inv.ends[segment], inv.reach[segment]), inv.roads)
+    zero = _within(ex, ey, b, np.arange(len(b.row)), np.zeros(len(b.row)), None, inv.roads)
+    branch = np.concatenate([branch, np.arange(len(b.row))])
+    heading = np.concatenate([heading, np.zeros(len(b.row))])
+    lo, hi = np.concatenate([lo, zero[0]]), np.concatenate([hi, zero[1]])
+    keep = lo <= hi
+    branch, heading, lo, hi = branch[keep], heading[keep], lo[keep], hi[keep]
+    order = np.lexsort((heading, branch))
+    branch, heading, lo, hi = branch[order], heading[order], lo[order], hi[order]
+    new = np.ones(len(branch), dtype=bool)
+    new[1:] = (branch[1:] != branch[:-1]) | (heading[1:] != heading[:-1])
+    starts = np.flatnonzero(new)
+    moved = b.take(branch[starts])
+    moved.lo, moved.hi = np.minimum.reduceat(lo, starts), np.maximum.reduceat(hi, starts)
+    heading = heading[starts]
+    moved.ax = moved.ax + np.sin(heading) / moved.steps
+    moved.ay = moved.ay - np.cos(heading) / moved.steps
+    moved.left = moved.left - 1
+    moved.first = np.where(moved.left == 0, heading, np.nan)
+    return _Moved(moved, heading, branch[starts])
+
+
+def _within(ex, ey, b: _Back, branch, heading, near, roads) -> tuple[np.ndarray, np.ndarray]:
+    """The D interval (lo > hi: none) on which branch ``branch[i]``'s point one step back along
+    ``heading[i]`` comes within ``near[1][i]`` metres of the segment ``near[0][i]`` (rows of
+    x0, y0, x1, y1), as the hull of that set; with ``near`` None, where it may leave the roads."""
+    ax = b.ax[branch] + np.sin(heading) / b.steps[branch]
+    ay = b.ay[branch] + -np.cos(heading) / b.steps[branch]
+    lo, hi = b.lo[branch], b.hi[branch]
+    x, y = ex[b.row[branch]], ey[b.row[branch]]
+    p = np.stack([x + lo * ax, y + lo * ay], axis=1)
+    q = np.stack([x + hi * ax, y + hi * ay], axis=1)
+    if near is None:
+        off = ~shapely.covered_by(shapely.linestrings(np.stack([p, q], axis=1)), roads)
+        return np.where(off, lo, np.inf), np.where(off, hi, -np.inf)
+    t_lo, t_hi = _stadium(p, q - p, near[0][:, :2], near[0][:, 2:], near[1])
+    return np.where(t_lo <= t_hi, lo + t_lo * (hi - lo), np.inf), lo + t_hi * (hi - lo)
+
+
+def _stadium(p, r, a, b, radius) -> tuple[np.ndarray, np.ndarray]:
+    """The hull [t_lo, t_hi] (t_lo > t_hi: empty) of the t in [0, 1] at which p + t r lies within
+    ``radius`` of the segment a-b: the union of the band along it and the discs at its ends."""
+    w = b - a
+    ww = np.einsum("ij,ij->i", w, w)
+    lows, highs = [], []
+    for centre in (a, b):
+        low, high = _quadratic_below(r, p - centre, radius)
+        lows.append(low)
+        highs.append(high)
+    length = np.sqrt(ww)
+    pa = p - a
+    low, high = np.zeros(len(p)), np.ones(len(p))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for f0, f1, bottom, top in (
+            (np.einsum("ij,ij->i", pa, w) / ww, np.einsum("ij,ij->i", r, w) / ww, 0.0, 1.0),
+            (_cross(w, pa) / length, _cross(w, r) / length, -radius, radius),
+        ):
+            low, high = _linear_within(low, high, f0, f1, bottom, top)
+    band = ww > 0
+    lows.append(np.where(band, low, np.inf))
+    highs.append(np.where(band, high, -np.inf))
+    lows_, highs_ = np.stack(lows), np.stack(highs)
+    empty = lows_ > highs_
+    t_lo = np.where(empty, np.inf, lows_).min(axis=0)
+    t_hi = np.where(empty, -np.inf, highs_).max(axis=0)
+    return t_lo, t_hi
+
+
+def _quadratic_below(r, d, radius) -> tuple[np.ndarray, np.ndarray]:
+    """The t in [0, 1] with |d + t r| <= radius, as an interval (low > high: none)."""
+    rr = np.einsum("ij,ij->i", r, r)
+    dr = np.einsum("ij,ij->i", d, r)
+    c = np.einsum("ij,ij->i", d, d) - radius * radius
+    moving = rr > DEGENERATE_M**2
+    disc = dr * dr - rr * c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+        low = np.where(moving, (-dr - root) / rr, np.where(c <= 0, 0.0, np.inf))
+        high = np.where(moving, (-dr + root) / rr, np.where(c <= 0, 1.0, -np.inf))
+    low, high = np.nan_to_num(low, nan=np.inf), np.nan_to_num(high, nan=-np.inf)
+    return np.maximum(low, 0.0), np.minimum(high, 1.0)
+
+
+def _linear_within(low, high, f0, f1, bottom, top) -> tuple[np.ndarray, np.ndarray]:
+    """Narrow [low, high] to the t where bottom <= f0 + f1 t <= top."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u, v = (bottom - f0) / f1, (top - f0) / f1
+    flat = np.abs(f1) <= 1e-300
+    inside = (f0 >= bottom) & (f0 <= top)
+    new_low = np.where(flat, np.where(inside, low, np.inf), np.maximum(low, np.minimum(u, v)))
+    new_high = np.where(flat, np.where(inside, high, -np.inf), np.minimum(high, np.maximum(u, v)))
+    return new_low, new_high
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+
+
+def _consistent(geometry: MapGeometry, field: Field, lw, ex, ey, moved: _Moved) -> _Moved:
+    """The D sub-intervals on which the field at each branch's new point takes its heading."""
+    b = moved.branches
+    branch, low, high = _split(lw, ex, ey, b, moved.heading)
+    mid = (low + high) / 2
+    at = geometry.scenic_headings(
+        field, ex[b.row[branch]] + mid * b.ax[branch], ey[b.row[branch]] + mid * b.ay[branch], _no_terms
+    )
+    keep = at == moved.heading[branch]
+    branch, low, high = _joined(branch[keep], low[keep], high[keep])
+    found = moved.take(branch)
+    found.branches.lo, found.branches.hi = low, high
+    found.branches.first = np.full(len(branch), np.nan)
+    return found
+
+
+def _joined(branch, low, high):
+    """Neighbouring kept sub-intervals of one branch joined (they share an end)."""
+    if not len(branch):
+        return branch, low, high
+    new = np.ones(len(branch), dtype=bool)
+    new[1:] = (branch[1:] != branch[:-1]) | (low[1:] != high[:-1])
+    starts = np.flatnonzero(new)
+    ends = np.append(starts[1:], len(branch)) - 1
+    return branch[starts], low[starts], high[ends]
+
+
+def _concat(parts: list[_Back]) -> _Back:
+    names = ("row", "lo", "hi", "steps", "ax", "ay", "left", "first")
+    return _Back(*(np.concatenate([getattr(p, k) for p in parts]) for k in names))
+
+
+def _no_terms(term):
+    raise ValueError(f"roadDirection has no parameters, got {term!r}")
+
+
+_INVERSE: weakref.WeakKeyDictionary[MapGeometry, Inverse] = weakref.WeakKeyDictionary()

@@ -15,8 +15,10 @@
 
 A row that follows ``roadDirection`` from a known start for a random distance skips these
 steps: :mod:`.walk` decides it exactly over the pieces of the walk, with a witness; one that
-follows it from a random point on a curb goes first to :mod:`.walk_start` (exact, with a
-witness), and to these steps only where that leaves it undecided.
+follows it from a random start (a point on a curb or of a region, a vector of ranges) goes first
+to :mod:`.walk_inverse` (the walk inverted, exact with a witness; its preimages, too, enumerated
+for all rows at once), a curb start then to :mod:`.walk_start` (forward over (s, D) regions), and
+to these steps only where those leave it undecided.
 
 The row is feasible when one piece is. Solver verdicts other than a proof of
 infeasibility keep the row (soundness first); ``delta-sat`` and ``undecided``

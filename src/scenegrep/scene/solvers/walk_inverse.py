@@ -27,8 +27,11 @@ piece boundaries of :mod:`..follow_pieces`). A row is undecided (the caller fall
 forward enumeration of :mod:`.walk_start` for a curb, else to the general solvers) when a segment
 meets the domain but no witness passes the check, or when the box is wider.
 
-Speed (Town01, ``benchmarks/bench_follow.py``, CPU ms per one-frame match; see the README):
-filled in by the benchmark section of the README.
+Speed (Town01, ``benchmarks/bench_follow.py``: 30 Scenic scenes per start, CPU ms per one-frame
+match, median / p95; refuted = the frames moved 3 m or turned 0.3 rad; same run's known start:
+4.8 / 9.9 matched): curb starts 18.4 / 30 matched, 11.2 / 27 refuted (before, with the forward
+enumeration of :mod:`.walk_start` alone: 105 median / 650 max matched, about 1.5 s refuted);
+region starts 26 / 93 matched, 10.4 / 63 refuted (before: the general solvers, no witness).
 """
 
 from __future__ import annotations

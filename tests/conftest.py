@@ -66,3 +66,14 @@ def real_dataset(real_data: Path, tmp_path_factory) -> Path:
     report = ingest([str(real_data), str(REPO / "examples" / "sample")], root, jobs=2, unknown_layers="strict")
     assert not report.failed, report.failed
     return root
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Test files holding a ``slow`` test run first, each file's tests kept together (their
+    module fixtures are built once): under ``pytest -n 2`` the long tests then start while the
+    many short ones are still queued to fill in around them, instead of one long test at the end
+    of the run leaving the other worker idle. (xdist's ``--dist loadgroup`` sends a group, such
+    as tests/library's, before single tests.) The sort is stable: otherwise collection order."""
+    slow_files = {item.path for item in items if item.get_closest_marker("slow")}
+    items.sort(key=lambda item: item.path not in slow_files)

@@ -49,9 +49,15 @@ the Cross checks use AV2, whose maps publish crossings."""
 
 
 @cache
+def raw(relative: str) -> LabelTrace:
+    """A real recording as read, once per process (the tests only read it)."""
+    return read_trace(SHARED / "real_data" / relative)
+
+
+@cache
 def recording(relative: str) -> tuple[LabelTrace, RoadMap | None]:
     """A real recording, labelled as ``scenegrep scenario`` labels it, and its map."""
-    trace = read_trace(SHARED / "real_data" / relative)
+    trace = raw(relative)
     road_map = read_map(trace.map_source) if trace.map_source is not None else None
     return label_trace(trace, road_map, unknown_layers=UnknownLayers(CHOICE)).trace, road_map
 
@@ -88,7 +94,7 @@ def other_answers(relative: str, kind: str, primitive: str, window: int) -> dict
 
 def raw_track(relative: str, object_id: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Frames, times (s), x, y (m) and headings (rad) of one object, as recorded, in time order."""
-    trace = read_trace(SHARED / "real_data" / relative)
+    trace = raw(relative)
     rows = np.flatnonzero(trace.states.object == trace.object_index(object_id))
     rows = rows[np.argsort(trace.states.frame[rows])]
     s = trace.states
@@ -138,7 +144,7 @@ def test_turn_right_finds_the_right_turn_of_nuscenes_0916():
 def leftward_offsets(relative: str) -> dict[str, np.ndarray]:
     """Per vehicle, its position across the road (m, towards the left of the traffic), frame by frame:
     the road is straight, so its direction is the mean of every recorded heading."""
-    trace = read_trace(SHARED / "real_data" / relative)
+    trace = raw(relative)
     s = trace.states
     road = np.arctan2(np.sin(s.heading).mean(), np.cos(s.heading).mean())
     offsets = {}
@@ -225,7 +231,7 @@ def test_walk_finds_walking_pedestrians_and_not_standing_ones():
     relative = NUSC.format("0061")
     window = 50
     found = other_answers(relative, "Pedestrian", "Walk", window)
-    trace = read_trace(SHARED / "real_data" / relative)
+    trace = raw(relative)
     walking, standing = set(), set()
     for k, object_id in enumerate(trace.objects.id):
         f, t, x, y, _ = raw_track(relative, str(object_id))

@@ -1,5 +1,11 @@
-"""Bag benchmarks (issue 18): per-frame online latency of ``--follow``; the bag reader's read throughput
-(messages per second, TrackedObjects with 50 objects per message) is the reader's section, to come.
+"""Bag benchmarks (issue 18): per-frame online latency of ``--follow``, and the bag reader's read
+throughput (``--read N``).
+
+**Read throughput.** A bag of N ``autoware_perception_msgs/TrackedObjects`` messages of
+``--objects`` objects each (every field written, covariances included: about 1.1 kB per object;
+boxes in ``base_link``), one ``/tf`` message per frame, zstd chunks, is read by the ``ros-bag``
+reader into one trace; messages per second (TrackedObjects messages over the whole read), and
+the MCAP stream alone (records read and decompressed, nothing decoded) for comparison.
 
 **Online latency.** A writer thread appends an MCAP file frame by frame at ``--rate`` frames per
 second (unchunked, as a live recorder writes) while ``scenegrep spre --follow FILE PATTERN`` runs in
@@ -23,7 +29,8 @@ Median and p99 in milliseconds; the first ``--warm-up`` frames are not counted e
 follower's first decode and query compile; the maximum over all frames is reported). The frames'
 count must equal the lines' (FAILED otherwise).
 
-    python benchmarks/bench_bag.py [--source strem|ros] [--frames 300] [--rate 30] [--boxes 20] [--json results.json]
+    python benchmarks/bench_bag.py [--source strem|ros] [--frames 300] [--rate 30] [--boxes 20]
+        [--read 100000] [--objects 50] [--no-latency] [--json results.json]
 """
 
 from __future__ import annotations
@@ -184,6 +191,78 @@ def wait_until_open(pid: int, path: Path) -> None:
     raise SystemExit("the follower never opened the file")
 
 
+def read_throughput(messages: int, objects: int) -> dict:
+    """Messages per second read by the ros-bag reader (see the module docstring)."""
+    sys.path.insert(0, str(REPO))
+    sys.path.insert(0, str(REPO / "src"))
+    from mcap_ros2._dynamic import serialize_dynamic
+
+    from scenegrep.readers.ros.bag import bag_messages
+    from scenegrep.readers.ros.reader import read_trace
+    from tests.readers.ros_writer import Box, ORIGIN_NS, schema, tracked_object
+
+    def encoder(name: str):
+        full = name.replace("/", "/msg/")
+        return serialize_dynamic(full, schema(name))[full], schema(name)
+
+    boxes = [
+        Box(
+            f"object-{k}",
+            "car",
+            "car",
+            {"x": 5.0 * k, "y": 2.0, "z": 0.0},
+            0.1 * k,
+            {"x": 4.5, "y": 1.9, "z": 1.6},
+            {"x": 3.0, "y": 0.0, "z": 0.0},
+        )
+        for k in range(objects)
+    ]
+    encode_objects, objects_schema = encoder("autoware_perception_msgs/TrackedObjects")
+    encode_tf, tf_schema = encoder("tf2_msgs/TFMessage")
+    header = {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": "base_link"}
+    template = bytearray(encode_objects({"header": header, "objects": [tracked_object(b) for b in boxes]}))
+    identity = {"translation": {"x": 0.0, "y": 0.0, "z": 0.0}, "rotation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}
+    link = {"header": {**header, "frame_id": "map"}, "child_frame_id": "base_link", "transform": identity}
+    tf_template = bytearray(encode_tf({"transforms": [link]}))
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "bench.mcap"
+        with open(path, "wb") as handle:
+            writer = Writer(handle, compression=CompressionType.ZSTD)
+            writer.start("ros2", "bench_bag")
+            objects_channel = writer.register_channel(
+                "/objects",
+                "cdr",
+                writer.register_schema(
+                    "autoware_perception_msgs/msg/TrackedObjects", "ros2msg", objects_schema.encode()
+                ),
+            )
+            tf_channel = writer.register_channel(
+                "/tf", "cdr", writer.register_schema("tf2_msgs/msg/TFMessage", "ros2msg", tf_schema.encode())
+            )
+            for i in range(messages):
+                stamp = ORIGIN_NS + i * 100_000_000
+                sec, nanosec = (stamp // 10**9).to_bytes(4, "little"), (stamp % 10**9).to_bytes(4, "little")
+                template[4:12] = tf_template[8:16] = sec + nanosec  # header stamps (the tf one after its count)
+                writer.add_message(tf_channel, stamp, bytes(tf_template), stamp)
+                writer.add_message(objects_channel, stamp, bytes(template), stamp)
+            writer.finish()
+        start = time.perf_counter()
+        records = sum(1 for _ in bag_messages(path))
+        stream_s = time.perf_counter() - start
+        start = time.perf_counter()
+        trace = read_trace(path)
+        read_s = time.perf_counter() - start
+    assert trace.n_frames == messages and len(trace.states) == messages * (objects + 1)
+    return {
+        "messages": messages,
+        "objects_per_message": objects,
+        "bytes_per_message": len(template),
+        "mcap_stream_messages_per_s": round(records / stream_s),
+        "read_messages_per_s": round(messages / read_s),
+        "read_s": round(read_s, 3),
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--source", choices=["strem", "ros"], default="strem")
@@ -191,15 +270,22 @@ def main() -> None:
     parser.add_argument("--rate", type=float, default=30.0, help="frames per second written")
     parser.add_argument("--boxes", type=int, default=20, help="boxes per frame (strem)")
     parser.add_argument("--warm-up", type=int, default=5, help="first frames not counted")
+    parser.add_argument("--read", type=int, default=0, metavar="N", help="TrackedObjects messages read (0: skip)")
+    parser.add_argument("--objects", type=int, default=50, help="objects per TrackedObjects message")
+    parser.add_argument("--no-latency", action="store_true", help="skip the online latency")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
-    if args.source == "strem":
-        frames, pattern = strem_frames(args.frames, args.boxes), [PATTERN]
-        details = {"source": "STREM documents", "boxes_per_frame": args.boxes}
-    else:
-        frames, pattern = ros_frames(args.frames), ["--space", "topdown", "[[:car:]]"]
-        details = {"source": "TrackedObjects + /tf (AV2 7fab2350)"}
-    report = {"online_latency": details | online_latency(frames, pattern, args.rate, args.warm_up)}
+    report = {}
+    if not args.no_latency:
+        if args.source == "strem":
+            frames, pattern = strem_frames(args.frames, args.boxes), [PATTERN]
+            details = {"source": "STREM documents", "boxes_per_frame": args.boxes}
+        else:
+            frames, pattern = ros_frames(args.frames), ["--space", "topdown", "[[:car:]]"]
+            details = {"source": "TrackedObjects + /tf (AV2 7fab2350)"}
+        report["online_latency"] = details | online_latency(frames, pattern, args.rate, args.warm_up)
+    if args.read:
+        report["read_throughput"] = read_throughput(args.read, args.objects)
     print(json.dumps(report, indent=2))
     if args.json:
         args.json.write_text(json.dumps(report, indent=2))

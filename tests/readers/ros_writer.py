@@ -479,3 +479,50 @@ def write_scene_updates(trace: LabelTrace, path: Path, encoding: str, origin_ns:
             data = update.SerializeToString()
         mcap.add_message(channel, log, data, log)
     writer.close()
+
+
+def _add_vision2d() -> None:
+    MSG.update(
+        {
+            "vision_msgs/Point2D": "float64 x\nfloat64 y",
+            "vision_msgs/Pose2D": "vision_msgs/Point2D position\nfloat64 theta",
+            "vision_msgs/BoundingBox2D": "vision_msgs/Pose2D center\nfloat64 size_x\nfloat64 size_y",
+            "vision_msgs/Detection2D": (
+                "std_msgs/Header header\nObjectHypothesisWithPose[] results\nBoundingBox2D bbox\nstring id"
+            ),
+            "vision_msgs/Detection2DArray": "std_msgs/Header header\nDetection2D[] detections",
+        }
+    )
+
+
+_add_vision2d()
+
+
+def camera_topic(channel: str) -> str:
+    """The topic a test writes a camera channel's detections on."""
+    return "/" + "".join(c if c.isalnum() else "_" for c in channel) + "/detections"
+
+
+def write_detections2d(trace: LabelTrace, path: Path, origin_ns: int = ORIGIN_NS) -> None:
+    """Write a trace's image boxes as ``vision_msgs/Detection2DArray``: one message per sample on
+    :func:`camera_topic` of its channel, its header frame id the channel, stamped ``origin_ns``
+    plus 100 ms per frame position; each box one detection with one hypothesis."""
+    writer = BagWriter(path)
+    samples, boxes = trace.images.samples, trace.images.boxes
+    for k in range(len(samples)):
+        stamp = origin_ns + int(samples.frame[k]) * 100_000_000
+        channel = samples.channels[samples.channel[k]]
+        header = {"stamp": _stamp(stamp), "frame_id": channel}
+        detections = []
+        for b in np.flatnonzero(boxes.sample == k):
+            hypothesis = {"class_id": boxes.classes[boxes.category[b]], "score": float(boxes.score[b])}
+            pose = {"pose": {"position": ZERO, "orientation": _quat(0.0)}, "covariance": COVARIANCE}
+            centre = {"position": {"x": float(boxes.cx[b]), "y": float(boxes.cy[b])}, "theta": float(boxes.rotation[b])}
+            bbox = {"center": centre, "size_x": float(boxes.w[b]), "size_y": float(boxes.h[b])}
+            detections.append(
+                {"header": header, "results": [{"hypothesis": hypothesis, "pose": pose}], "bbox": bbox, "id": ""}
+            )
+        writer.write(
+            camera_topic(channel), "vision_msgs/Detection2DArray", {"header": header, "detections": detections}, stamp
+        )
+    writer.close()

@@ -149,3 +149,56 @@ class ImageLayerBuilder:
             np.asarray(obj, np.int32),
         )
         return ImageLayer(samples, boxes)
+
+
+def concatenate_layers(parts: list[tuple[ImageLayer | None, int, np.ndarray]]) -> ImageLayer | None:
+    """The image layers of consecutive traces as one: each part is (layer or None, the frame
+    position its trace starts at, its object rows -> rows of the whole); channels and classes
+    are the union of the parts' in order of first appearance. None when no part has a layer."""
+    layers = [(layer, offset, objects) for layer, offset, objects in parts if layer is not None]
+    if not layers:
+        return None
+    channels: dict[str, int] = {}
+    classes: dict[str, int] = {}
+    samples: list[tuple] = []
+    boxes: list[tuple] = []
+    sample_offset = 0
+    for layer, offset, objects in layers:
+        s, b = layer.samples, layer.boxes
+        channel_map = np.array([channels.setdefault(c, len(channels)) for c in s.channels] + [0], dtype=np.int32)
+        class_map = np.array([classes.setdefault(c, len(classes)) for c in b.classes] + [0], dtype=np.int32)
+        samples.append((s.frame + offset, channel_map[s.channel], s.image_path, s.image_width, s.image_height))
+        box_objects = np.append(np.asarray(objects, dtype=np.int32), -1)[b.object]
+        boxes.append(
+            (
+                b.sample + sample_offset,
+                class_map[b.category],
+                b.score,
+                b.cx,
+                b.cy,
+                b.w,
+                b.h,
+                b.rotation,
+                b.oriented,
+                box_objects,
+            )
+        )
+        sample_offset += len(s)
+    frame, channel, path, width, height = (np.concatenate(c) for c in zip(*samples))
+    sample, category, score, cx, cy, w, h, rotation, oriented, obj = (np.concatenate(c) for c in zip(*boxes))
+    return ImageLayer(
+        SampleTable(tuple(channels), frame.astype(np.int32), channel, path, width, height),
+        BoxTable(
+            tuple(classes),
+            sample.astype(np.int32),
+            category,
+            score,
+            cx,
+            cy,
+            w,
+            h,
+            rotation,
+            oriented,
+            obj.astype(np.int32),
+        ),
+    )

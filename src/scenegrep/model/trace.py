@@ -18,7 +18,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from .behaviours import BehaviourLabels
-from .images import ImageLayer
+from .images import ImageLayer, concatenate_layers
 from .objects import ObjectTable
 from .states import StateTable
 
@@ -314,17 +314,17 @@ def _optional_equal(a: Any, b: Any) -> bool:
 def concatenate(traces: list[LabelTrace]) -> LabelTrace:
     """The frames of ``traces`` one after the other (e.g. chunks of a stream); objects with the same
     id are the same object. Name, ego, attributes and map come from the first trace; behaviour
-    labels are kept if every trace has them; image layers are not concatenated (ValueError)."""
-    if any(t.images is not None for t in traces):
-        raise ValueError("traces with image layers cannot be concatenated")
+    labels are kept if every trace has them; image layers are joined (:func:`concatenate_layers`)."""
     ids: dict[str, int] = {}
     categories: list[str] = []
     attributes: list[dict[str, Any]] = []
     lanes: dict[str, int] = {}
     parts = []
+    image_parts = []
     offset = 0
     for trace in traces:
         object_map = np.array([ids.setdefault(str(i), len(ids)) for i in trace.objects.id], dtype=np.int32)
+        image_parts.append((trace.images, offset, object_map))
         for row in np.flatnonzero(object_map >= len(categories)):
             categories.append(str(trace.objects.category[row]))
             attributes.append(dict(trace.objects.attributes[row]))
@@ -351,6 +351,7 @@ def concatenate(traces: list[LabelTrace]) -> LabelTrace:
         states,
         lane_ids=tuple(lanes),
         behaviours=behaviours,
+        images=concatenate_layers(image_parts),
         ego=first.ego,
         attributes=first.attributes,
         source=first.source,

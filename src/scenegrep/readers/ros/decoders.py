@@ -14,6 +14,9 @@ field order or added field of a message version is read right). Supported types 
 - ``vision_msgs/Detection3DArray``: the box (centre pose, size), the most probable hypothesis's
   ``class_id`` as the class, ``id`` (the tracking id; ``<stamp ns>:<rank>`` where empty), each
   detection's own header where it has one (frame id not empty, stamp not zero);
+- ``vision_msgs/Detection2DArray``: image boxes (centre, size, rotation ``theta``), the most
+  probable hypothesis's class and score; one camera channel per header frame id (the topic when
+  empty); the image size is not in the message (unknown);
 - ``foxglove.SceneUpdate`` in JSON or protobuf (:mod:`.foxglove`): cube entities;
 - ``tf2_msgs/TFMessage`` (``/tf``, ``/tf_static``) and ``nav_msgs/Odometry`` (a link from its
   ``header.frame_id`` to its ``child_frame_id``).
@@ -26,12 +29,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
 from .cdr import Level, Payloads, decode
 from .foxglove import SCENE_UPDATE, decode_scene_updates
-from .messages import Boxes, RawMessage, Transforms
+from .messages import Boxes, ImageBoxes, RawMessage, Transforms
 from .msgdef import Field, normalise, parse_schema
 
 AUTOWARE_LABELS = (
@@ -213,6 +217,47 @@ def _vision3d() -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:
     return frozenset(wanted), boxes
 
 
+def _vision2d(topic: str) -> tuple[frozenset[str], Callable[[dict[str, Level]], ImageBoxes]]:
+    centre = "detections.bbox.center."
+    wanted = {"header.stamp.sec", "header.stamp.nanosec", "header.frame_id", "detections.bbox.size_x"}
+    wanted |= {"detections.bbox.size_y", f"{centre}theta", *(f"{centre}position.{a}" for a in "xy")}
+    wanted |= {f"{centre}{a}" for a in "xy"}  # vision_msgs 3 (geometry_msgs/Pose2D centre)
+    wanted |= {"detections.results.hypothesis.class_id", "detections.results.hypothesis.score"}
+
+    def boxes(levels: dict[str, Level]) -> ImageBoxes:
+        top, found = levels[""], levels.get("detections")
+        stamps, frames = _stamp(top.fields), _frames(top.fields["header.frame_id"])
+        channels = np.where(frames != "", frames, topic)
+        if found is None or not len(found.parent):
+            empty = np.empty(0)
+            return ImageBoxes(np.empty(0, np.int64), np.empty(0, dtype=object), *[empty] * 6, stamps, channels)
+        rows = _ordered(found)
+        f = found.fields
+        position = "bbox.center.position." if "bbox.center.position.x" in f else "bbox.center."
+        results = levels.get("detections.results")
+        best = _best(results, "hypothesis.score", len(found.parent))[rows]
+        category = np.full(len(rows), "unknown", dtype=object)
+        score = np.full(len(rows), np.nan)
+        if results is not None:
+            category[best >= 0] = results.fields["hypothesis.class_id"][best[best >= 0]]
+            score[best >= 0] = results.fields["hypothesis.score"][best[best >= 0]]
+        column = lambda name: f[name][rows].astype(np.float64)  # noqa: E731
+        return ImageBoxes(
+            found.parent[rows],
+            category,
+            score,
+            column(position + "x"),
+            column(position + "y"),
+            column("bbox.size_x"),
+            column("bbox.size_y"),
+            column("bbox.center.theta"),
+            stamps,
+            channels,
+        )
+
+    return frozenset(wanted), boxes
+
+
 def _tf() -> tuple[frozenset[str], Callable[[dict[str, Level]], Transforms]]:
     prefix = "transforms."
     wanted = {prefix + n for n in ("header.stamp.sec", "header.stamp.nanosec", "header.frame_id", "child_frame_id")}
@@ -260,12 +305,13 @@ def _no_links() -> Transforms:
     return Transforms(empty, empty, text, text, np.empty((0, 3)), np.empty((0, 4)))
 
 
-_DECODERS: dict[str, Callable[[], tuple[frozenset[str], Callable[[dict[str, Level]], Boxes | Transforms]]]] = {
+_DECODERS: dict[str, Callable[..., tuple[frozenset[str], Callable[[dict[str, Level]], Any]]]] = {
     "autoware_perception_msgs/TrackedObjects": lambda: _autoware(True),
     "autoware_auto_perception_msgs/TrackedObjects": lambda: _autoware(True),
     "autoware_perception_msgs/DetectedObjects": lambda: _autoware(False),
     "autoware_auto_perception_msgs/DetectedObjects": lambda: _autoware(False),
     "vision_msgs/Detection3DArray": _vision3d,
+    "vision_msgs/Detection2DArray": _vision2d,
     "tf2_msgs/TFMessage": _tf,
     "nav_msgs/Odometry": _odometry,
 }
@@ -274,6 +320,9 @@ BOX_TYPES = frozenset(name for name in (*_DECODERS, SCENE_UPDATE) if not name.st
 """The message types that give boxes."""
 
 LINK_TYPES = frozenset({"tf2_msgs/TFMessage", "nav_msgs/Odometry"})
+
+IMAGE_TYPES = frozenset({"vision_msgs/Detection2DArray"})
+"""The box types whose boxes are in an image (the others give 3-D boxes)."""
 """The message types that give frame links."""
 
 
@@ -290,7 +339,7 @@ def supported(schema_name: str, message_encoding: str) -> bool:
     return message_encoding == "cdr" and type_key(schema_name) in _DECODERS
 
 
-def decode_batch(messages: Sequence[RawMessage]) -> Boxes | Transforms:
+def decode_batch(messages: Sequence[RawMessage]) -> Boxes | ImageBoxes | Transforms:
     """The boxes or links of a batch of messages of one topic (one supported schema and encoding):
     DecodeError names the first bad message; DefinitionError a schema that cannot be read; KeyError
     a field the decoder needs that the schema lacks."""
@@ -298,6 +347,6 @@ def decode_batch(messages: Sequence[RawMessage]) -> Boxes | Transforms:
     if first.schema_name == SCENE_UPDATE:
         return decode_scene_updates(messages)
     key = type_key(first.schema_name)
-    wanted, build = _DECODERS[key]()
+    wanted, build = _DECODERS[key](first.topic) if key in IMAGE_TYPES else _DECODERS[key]()
     payloads = Payloads.of([m.data for m in messages])
     return build(decode(types_of(first.schema_name, first.schema_data), key, payloads, wanted))

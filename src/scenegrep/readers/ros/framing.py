@@ -39,10 +39,10 @@ import numpy as np
 import pyarrow as pa
 
 from ...errors import UserError
-from ...model import LabelTrace, ObjectTable, StateTable, TraceSource
+from ...model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
 from ...model.geometry import heading_from_yaw
 from .decoders import BOX_TYPES, LINK_TYPES, decode_batch, supported, type_key
-from .messages import Boxes, DecodeError, RawMessage
+from .messages import Boxes, DecodeError, ImageBoxes, RawMessage
 from .msgdef import DefinitionError
 from .options import BagOptions
 from .transforms import MissingTransform, TfBuffer, quat_multiply, quat_rotate, yaw_of
@@ -230,6 +230,8 @@ class FrameBuilder:
         needs none)."""
         need: dict[str, int] = {}
         for seg, rows, _ in picks:
+            if isinstance(seg.boxes, ImageBoxes):
+                continue
             rows_of = np.isin(seg.boxes.message, rows)
             for frame_id in set(seg.boxes.frame_id[rows_of].tolist()):
                 if frame_id != self.options.map_frame:
@@ -267,8 +269,11 @@ class FrameBuilder:
 
     # ------------------------------------------------------------------ building
     def _chunk(self, stamps: np.ndarray, picks: list) -> LabelTrace:
+        images = _image_layer([p for p in picks if isinstance(p[0].boxes, ImageBoxes)])
         parts = []
         for seg, rows, frames in picks:
+            if isinstance(seg.boxes, ImageBoxes):
+                continue
             frame_of = np.full(len(seg.stamps), -1)
             frame_of[rows] = frames
             taken = seg.boxes.take(frame_of[seg.boxes.message] >= 0)
@@ -289,7 +294,7 @@ class FrameBuilder:
             categories.append(np.full(len(stamps), EGO_ID, dtype=object))
             frame.append(np.arange(len(stamps)))
             columns.append(ego)
-        return self._trace(stamps, ids, categories, frame, columns, ego is not None)
+        return self._trace(stamps, ids, categories, frame, columns, ego is not None, images)
 
     def _to_map(self, seg: _Segment, boxes: Boxes) -> tuple[np.ndarray, np.ndarray]:
         xyz, quat = boxes.xyz.copy(), boxes.quat.copy()
@@ -319,7 +324,7 @@ class FrameBuilder:
         unknown = np.full((len(stamps), 5), np.nan)
         return np.column_stack([xyz, heading_from_yaw(yaw_of(quat)), unknown])
 
-    def _trace(self, stamps, ids, categories, frame, columns, has_ego: bool) -> LabelTrace:
+    def _trace(self, stamps, ids, categories, frame, columns, has_ego: bool, images: ImageLayer | None) -> LabelTrace:
         if self.origin is None:
             self.origin = int(stamps[0])
         frame_all = np.concatenate(frame).astype(np.int64) if frame else np.empty(0, np.int64)
@@ -360,11 +365,70 @@ class FrameBuilder:
             ObjectTable.build(names.tolist(), [str(c) for c in category]),
             states,
             ego=EGO_ID if has_ego else None,
+            images=images,
             attributes={"dataset": "ros2-bag", "time_origin_ns": self.origin},
             source=self.source,
         )
         self.emitted += len(stamps)
         return chunk
+
+
+def _image_layer(picks: list[tuple[_Segment, np.ndarray, np.ndarray]]) -> ImageLayer | None:
+    """The images of the chosen 2-D detection messages: one sample per message (its channel, its
+    frame; no path, size unknown: 0), its boxes (no object: -1); samples in frame order."""
+    if not picks:
+        return None
+    channels: dict[str, int] = {}
+    classes: dict[str, int] = {}
+    sample_frame, sample_channel, box_parts = [], [], []
+    count = 0
+    for seg, rows, frames in picks:
+        boxes: ImageBoxes = seg.boxes  # type: ignore[assignment]
+        order = np.argsort(frames, kind="stable")
+        rows, frames = rows[order], frames[order]
+        sample_of = np.full(len(seg.stamps), -1)
+        sample_of[rows] = count + np.arange(len(rows))
+        sample_frame.append(frames)
+        sample_channel.append(
+            np.array([channels.setdefault(str(c), len(channels)) for c in boxes.message_channels[rows]], dtype=np.int32)
+        )
+        taken = boxes.take(sample_of[boxes.message] >= 0)
+        category = np.array([classes.setdefault(str(c), len(classes)) for c in taken.category], dtype=np.int32)
+        box_parts.append((sample_of[taken.message], category, taken))
+        count += len(rows)
+    frame = np.concatenate(sample_frame)
+    by_frame = np.argsort(frame, kind="stable")
+    renumber = np.empty(count, dtype=np.int64)
+    renumber[by_frame] = np.arange(count)
+    sample = np.concatenate([renumber[p[0]] for p in box_parts]).astype(np.int32)
+    order = np.argsort(sample, kind="stable")
+
+    def column(name: str) -> np.ndarray:
+        return np.concatenate([getattr(p[2], name) for p in box_parts]).astype(np.float64)[order]
+
+    rotation = column("rotation")
+    samples = SampleTable(
+        tuple(channels),
+        frame[by_frame].astype(np.int32),
+        np.concatenate(sample_channel)[by_frame],
+        np.full(count, "", dtype=object),
+        np.zeros(count, dtype=np.int32),
+        np.zeros(count, dtype=np.int32),
+    )
+    box_table = BoxTable(
+        tuple(classes),
+        sample[order],
+        np.concatenate([p[1] for p in box_parts])[order],
+        column("score").astype(np.float32),
+        column("cx"),
+        column("cy"),
+        column("w"),
+        column("h"),
+        rotation,
+        rotation != 0,
+        np.full(len(sample), -1, dtype=np.int32),
+    )
+    return ImageLayer(samples, box_table)
 
 
 def _by_topic(chosen: list[tuple[_Segment, np.ndarray, np.ndarray]]) -> dict[str, list]:

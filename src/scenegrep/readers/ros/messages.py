@@ -72,3 +72,31 @@ class Transforms:
 
     def __len__(self) -> int:
         return len(self.message)
+
+
+@dataclass(frozen=True)
+class ImageBoxes:
+    """2-D detections, one row per box: ``message`` (position in the batch), ``category``,
+    ``score``, centre ``cx``/``cy``, size ``w``/``h`` (pixels) and ``rotation`` (rad);
+    per message of the batch: ``message_stamps`` (ns) and ``message_channels`` (its camera's
+    frame id, else its topic), so a message without detections is still an image."""
+
+    message: np.ndarray
+    category: np.ndarray
+    score: np.ndarray
+    cx: np.ndarray
+    cy: np.ndarray
+    w: np.ndarray
+    h: np.ndarray
+    rotation: np.ndarray
+    message_stamps: np.ndarray
+    message_channels: np.ndarray
+
+    ROWS = ("message", "category", "score", "cx", "cy", "w", "h", "rotation")
+
+    def __len__(self) -> int:
+        return len(self.message)
+
+    def take(self, rows: np.ndarray) -> ImageBoxes:
+        """The rows selected by an index or boolean array (the per-message arrays kept whole)."""
+        return ImageBoxes(*(getattr(self, f)[rows] for f in self.ROWS), self.message_stamps, self.message_channels)

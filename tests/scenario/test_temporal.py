@@ -145,8 +145,9 @@ def answers(query, trace: LabelTrace, m: int) -> set[tuple[str, int]]:
 @given(formulas(), traces(), st.integers(1, 5))
 def test_windows_equal_the_brute_force_evaluator(f, trace, m):
     program = f"{HEADER}require {render(f)}\n"
-    expected = brute_force(compile_scenario(program, "random.scenic"), f, trace, m)
-    assert answers(compile_scenario(program, "random.scenic"), trace, m) == expected
+    query = compile_scenario(program, "random.scenic")
+    expected = brute_force(query, f, trace, m)
+    assert answers(query, trace, m) == expected
     fallback = compile_scenario(program, "random.scenic")
     fallback.state_budget = 2  # every monitor over budget: the configuration-set simulation
     assert answers(fallback, trace, m) == expected

@@ -7,6 +7,7 @@ a behaviour stands still. Small hand-built label traces; the real-data checks ar
 from __future__ import annotations
 
 import importlib.util
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -15,9 +16,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.errors import UserError
-from scenegrep.model import BehaviourLabels, LabelTrace, ObjectTable, StateTable
+from scenegrep.model import BehaviourLabels, LabelTrace, ObjectTable, RoadMap, StateTable
 from scenegrep.model.layers import UnknownLayers
-from scenegrep.scenario import ScenarioOptions, compile_scenario, load_scenario
+from scenegrep.scenario import ScenarioOptions, ScenarioQuery, compile_scenario, load_scenario
 from scenegrep.scenario.vocabulary import load_vocabulary, read_vocabulary
 from tests.model.maps import synthetic_map
 
@@ -133,13 +134,20 @@ def test_any_behaviour_matches_a_moving_object_the_default_refuses():
     assert compile_scenario(fig1_with_any()).match(worked_trace(), 5, road_map=worked_map()).matched
 
 
+@cache
+def any_query_and_map() -> tuple[ScenarioQuery, RoadMap]:
+    """Figure 1 with AnyBehavior, compiled once, and the worked example's map (one query over many
+    traces and one map, as a run over a dataset uses them)."""
+    return compile_scenario(fig1_with_any()), worked_map()
+
+
 @settings(max_examples=100, deadline=None)
 @given(traces(), st.integers(1, 5))
 def test_any_behaviour_agrees_with_the_brute_force_reference(trace, m):
-    query = compile_scenario(fig1_with_any())
-    result = query.match(trace, m, road_map=worked_map(), options=ScenarioOptions(find_all=True))
+    query, road_map = any_query_and_map()
+    result = query.match(trace, m, road_map=road_map, options=ScenarioOptions(find_all=True))
     fast = {(tuple(sorted(match.correspondence.items())), int(s)) for match in result.matches for s in match.starts}
-    assert fast == reference_matches(query, trace, m, road_map=worked_map())
+    assert fast == reference_matches(query, trace, m, road_map=road_map)
 
 
 def test_any_behaviour_admits_every_label_set_also_an_empty_one():

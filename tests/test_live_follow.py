@@ -32,7 +32,7 @@ from scenegrep.readers.mcap_follow import RawMessage, follow_mcap
 from scenegrep.writers.trace_json import trace_document, write_trace_json
 from scenegrep.writers.trace_parquet import write_map_parquet
 
-from .readers.ros_writer import TRACKED_TOPIC, write_tracked
+from .readers.ros_writer import TRACKED_TOPIC, write_detections2d, write_tracked
 from .scenario.worked_example import worked_map, worked_trace
 
 FIG1 = "examples/queries/fig1_lane_change.scenic"
@@ -289,3 +289,28 @@ def test_latency_line_gives_median_and_p99_in_milliseconds():
     latency.matches.append(0.0025)
     assert latency.line() == ("latency: 4 frames, median 2.50 ms, p99 3.97 ms; 1 match, median 2.50 ms, p99 2.50 ms")
     assert Latency(time.perf_counter, keep=False).line() == "latency: 0 frames; 0 matches"
+
+
+@pytest.mark.parametrize("pattern", ["[[:car:]]+", "[[:car:]][[:pedestrian:]]", "[[:pedestrian:]]"])
+def test_detection2d_messages_on_stdin_give_the_stream_answers(conformance_dir, tmp_path, monkeypatch, capsys, pattern):
+    """A STREM stream written as vision_msgs/Detection2DArray (tests/readers/ros_writer.py), piped in:
+    the matches ``spre --online`` finds on the STREM file itself."""
+    stream = conformance_dir / "strem/data/seq_a.json"
+    write_detections2d(readers.read_trace(stream), tmp_path / "boxes.mcap")
+    main(["spre", "--online", pattern, str(stream)])
+    expected = [line.rsplit(":", 1)[1] for line in capsys.readouterr().out.splitlines()]
+    code, lines, _ = stdin_run(
+        monkeypatch, capsys, (tmp_path / "boxes.mcap").read_bytes(), ["spre", "--online", pattern]
+    )
+    assert lines == expected and code == (0 if expected else 1)
+
+
+def test_a_second_camera_arriving_after_the_frame_topic_is_dropped_with_a_note(
+    conformance_dir, tmp_path, monkeypatch, capsys
+):
+    """Two cameras, one message each per frame: fed one message at a time, a frame is complete at its
+    frame-topic message, so the other camera's message of the same stamp comes late (no traceback)."""
+    write_detections2d(readers.read_trace(conformance_dir / "strem/data/channels.json"), tmp_path / "two.mcap")
+    code, lines, err = stdin_run(monkeypatch, capsys, (tmp_path / "two.mcap").read_bytes(), ["spre", "--online", "."])
+    assert code == 0 and lines and "Traceback" not in err
+    assert "box messages arrived after their frame was built and were dropped" in err

@@ -212,6 +212,8 @@ class FrameBuilder:
     def _latest_per_frame(items: list[tuple[_Segment, np.ndarray, np.ndarray]]) -> list:
         """Of one topic's messages, the latest stamped (the last received on a tie) per frame."""
         stamps = np.concatenate([seg.stamps[rows] for seg, rows, _ in items])
+        if not len(stamps):  # none of its messages falls in these frames (one message fed at a time)
+            return items
         frames = np.concatenate([f for _, _, f in items])
         arrival = np.arange(len(stamps))
         order = np.lexsort((arrival, stamps, frames))

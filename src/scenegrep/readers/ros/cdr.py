@@ -5,9 +5,14 @@ is aligned to its size (8 at most) from the start of the payload after the 4-byt
 encapsulation header; a string or a sequence is a ``uint32`` count followed by its elements.
 
 :func:`decode` walks a type over a :class:`Payloads` batch *field by field for all messages at
-once*: every primitive field is one numpy gather over the batch, and a sequence of structs is
-walked position by position (element j of every message whose sequence is longer than j),
-so the Python work is per field and sequence position, not per message or element. The result
+once*: every primitive field is one numpy gather over the batch (a struct of k values of one
+type, a point or a quaternion, one (n, k) gather; a fixed-size struct not wanted one skip). A
+sequence of structs is first walked *speculatively* all at once, every element placed as if the
+elements of its sequence were as long as its first (the usual case: every object of a message
+has as many classifications and footprint points); the walk proves itself when each element
+ends where the next was placed. Otherwise it is walked position by position (element j of
+every message whose sequence is longer than j). So the Python work is per field (and, at
+worst, per sequence position), never per message or element. The result
 is a set of :class:`Level` tables: the messages (level ``""``) and one per sequence of structs
 or strings (``objects``, ``objects.classification``), each item naming its parent item.
 
@@ -221,8 +226,28 @@ class _Walker:
                 if want:
                     self._store(level, path, texts)
                 return pos
-            return self.struct(f.type, level, path + ".", owner, items, pos)
+            return self._struct_field(f, level, path, full, want, owner, items, pos)
         return self.sequence(f, full, want, owner, items, pos)
+
+    def _struct_field(self, f: Field, level: str, path: str, full: str, want: bool, owner, items, pos) -> np.ndarray:
+        """A struct field: skipped at once when plain and not wanted; read as one (n, k) gather
+        when its k fields are single values of one primitive type (a point, a quaternion)."""
+        plain = self.plain(f.type)
+        if plain is not None and not want:
+            pos = _align(pos, plain[1])
+            self._check(owner, pos + plain[0], full)
+            return pos + plain[0]
+        fields = self.types[f.type]
+        kinds = {(g.type, g.count) for g in fields}
+        if len(kinds) == 1 and next(iter(kinds))[1] is None and fields[0].type in PRIMITIVE_SIZES and len(fields) > 1:
+            size = PRIMITIVE_SIZES[fields[0].type]
+            pos = _align(pos, size)
+            values = self._read(_DTYPES[fields[0].type], len(fields), owner, pos, full)
+            for k, g in enumerate(fields):
+                if self._want(f"{full}.{g.name}"):
+                    self._store(level, f"{path}.{g.name}", values[:, k])
+            return pos + size * len(fields)
+        return self.struct(f.type, level, path + ".", owner, items, pos)
 
     def sequence(self, f: Field, full: str, want: bool, owner, items, pos) -> np.ndarray:
         """A fixed array of strings or structs, or a sequence: primitives and plain structs not
@@ -238,6 +263,10 @@ class _Walker:
             self._check(owner, pos, full)
             return pos
         collect = self.levels.setdefault(full, _Collect())
+        if f.type not in STRINGS and f.type not in PRIMITIVE_SIZES and int(n.max(initial=0)) > 1:
+            end = self._uniform(f, full, owner, items, pos, n, collect)
+            if end is not None:
+                return end
         pos = pos.copy()
         for j in range(int(n.max(initial=0))):
             active = np.flatnonzero(n > j)
@@ -256,6 +285,57 @@ class _Walker:
             else:
                 pos[active] = self.struct(f.type, full, "", owner[active], ids, pos[active])
         return pos
+
+    def _uniform(self, f: Field, full: str, owner, items, pos, n, collect: _Collect) -> np.ndarray | None:
+        """Walk every element of a sequence of structs at once, each at the place it would have
+        if all the elements of its sequence were as long as its first; the end of the sequence
+        when the walk confirms it (each element ends where the next was taken to start, so every
+        place was right), else None with nothing kept (the caller walks element by element)."""
+        some = np.flatnonzero(n > 0)
+        scratch = _Walker(self.types, frozenset(), self.data)
+        try:
+            first_end = scratch.struct(f.type, full, "", owner[some], items[some], pos[some])
+        except CdrError:
+            return None
+        counts = n[some]
+        stride = first_end - pos[some]
+        parent = np.repeat(some, counts)
+        rank = np.arange(len(parent)) - np.repeat(np.cumsum(counts) - counts, counts)
+        starts = np.repeat(pos[some], counts) + rank * np.repeat(stride, counts)
+        saved = {
+            name: (len(c.parent), c.count, {k: len(v) for k, v in c.fields.items()}) for name, c in self.levels.items()
+        }
+        ids = collect.count + np.arange(len(parent))
+        collect.count += len(parent)
+        collect.parent.append(items[parent])
+        collect.rank.append(rank)
+        try:
+            ends = self.struct(f.type, full, "", owner[parent], ids, starts)
+        except CdrError:
+            ends = None
+        last = np.r_[parent[1:] != parent[:-1], True]
+        if ends is None or not np.array_equal(ends[~last], starts[1:][~last[:-1]]):
+            self._rollback(saved)
+            return None
+        end = pos.copy()
+        end[parent[last]] = ends[last]
+        return end
+
+    def _rollback(self, saved: dict) -> None:
+        """Forget what was collected since ``saved`` (levels' lengths) was taken."""
+        for name in list(self.levels):
+            if name not in saved:
+                del self.levels[name]
+                continue
+            parents, count, fields = saved[name]
+            c = self.levels[name]
+            del c.parent[parents:], c.rank[parents:]
+            c.count = count
+            for key in list(c.fields):
+                if key in fields:
+                    del c.fields[key][fields[key] :]
+                else:
+                    del c.fields[key]
 
 
 def decode(

@@ -36,7 +36,6 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-import pyarrow as pa
 
 from ...errors import UserError
 from ...model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
@@ -336,9 +335,9 @@ class FrameBuilder:
         values = (np.concatenate(columns) if columns else np.empty((0, 9)))[by_frame]
         category_all = (np.concatenate(categories) if categories else np.empty(0, dtype=object))[by_frame]
         # objects in the order they first appear (so chunks concatenate to the same table)
-        encoded = pa.array(ids_all, type=pa.string()).dictionary_encode()
-        inverse = encoded.indices.to_numpy(zero_copy_only=False).astype(np.int64)
-        names = np.asarray(encoded.dictionary.to_pylist(), dtype=object)
+        index: dict[str, int] = {}
+        inverse = np.fromiter((index.setdefault(i, len(index)) for i in ids_all), dtype=np.int64, count=len(ids_all))
+        names = np.array(list(index), dtype=object)
         # codes are numbered in order of first appearance: a code is new where it passes every earlier one
         seen = np.maximum.accumulate(inverse) if len(inverse) else inverse
         first = np.flatnonzero(np.r_[len(inverse) > 0, inverse[1:] > seen[:-1]])

@@ -102,7 +102,7 @@ def _best_class(levels: dict[str, Level], n_objects: int) -> np.ndarray:
     classes = levels.get("objects.classification")
     best = _best(classes, "probability", n_objects)
     label = np.zeros(n_objects, dtype=np.int64)
-    if classes is not None:
+    if (best >= 0).any():  # (a level of no rows has no fields)
         label[best >= 0] = classes.fields["label"][best[best >= 0]]
     return np.where(label < len(AUTOWARE_LABELS), label, 0)
 
@@ -195,7 +195,7 @@ def _vision3d() -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:
         results = levels.get("detections.results")
         best = _best(results, "hypothesis.score", len(found.parent))[rows]
         category = np.full(len(rows), "unknown", dtype=object)
-        if results is not None:
+        if (best >= 0).any():  # (a level of no rows has no fields)
             category[best >= 0] = results.fields["hypothesis.class_id"][best[best >= 0]]
         given = f["id"][rows]
         ids = np.array(
@@ -238,7 +238,7 @@ def _vision2d(topic: str) -> tuple[frozenset[str], Callable[[dict[str, Level]], 
         best = _best(results, "hypothesis.score", len(found.parent))[rows]
         category = np.full(len(rows), "unknown", dtype=object)
         score = np.full(len(rows), np.nan)
-        if results is not None:
+        if (best >= 0).any():  # (a level of no rows has no fields)
             category[best >= 0] = results.fields["hypothesis.class_id"][best[best >= 0]]
             score[best >= 0] = results.fields["hypothesis.score"][best[best >= 0]]
         column = lambda name: f[name][rows].astype(np.float64)  # noqa: E731

@@ -314,3 +314,12 @@ def test_a_second_camera_arriving_after_the_frame_topic_is_dropped_with_a_note(
     code, lines, err = stdin_run(monkeypatch, capsys, (tmp_path / "two.mcap").read_bytes(), ["spre", "--online", "."])
     assert code == 0 and lines and "Traceback" not in err
     assert "box messages arrived after their frame was built and were dropped" in err
+
+
+def test_idle_timeout_ends_following_a_writer_that_stopped(files, capsys):
+    target = files / "stopped.mcap"
+    target.write_bytes(mcap_file(strem_messages(), finish=False))
+    started = time.monotonic()
+    code = main(["spre", "[[:car:]][[:pedestrian:]]", "--follow", str(target), "--idle-timeout", "0.3"])
+    assert code == 0 and 0.3 <= time.monotonic() - started < 5
+    assert capsys.readouterr().out.splitlines() == [f"{target}:{k - 1}-{k}" for k in (2, 5, 8)]

@@ -298,3 +298,27 @@ def test_a_malformed_scene_update_names_topic_and_log_time(short, tmp_path, data
         f"topic /markers, message at log time {messages[target].log_time} ns: not a valid foxglove.SceneUpdate" in line
     )
     assert reason in line
+
+
+def test_a_sqlite_bag_directory_reads_as_the_same_messages_in_mcap(short, tmp_path):
+    """A rosbag2 directory of .db3 files (written with rosbags, the definitions stored) is read
+    through rosbags into the same trace as the MCAP file of the same messages."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    trace, folder = short
+    mcap = folder / "for_db3.mcap"
+    write_tracked(trace, mcap, ORIGIN)
+    messages = list(bag_messages(mcap))
+    with Writer(tmp_path / "bag", version=9, storage_plugin=StoragePlugin.SQLITE3) as writer:
+        connections = {}
+        for m in messages:
+            if m.topic not in connections:
+                definition = m.schema_data.decode()
+                connections[m.topic] = writer.add_connection(
+                    m.topic, m.schema_name, msgdef=definition, rihs01="RIHS01_" + "0" * 64
+                )
+            writer.write(connections[m.topic], m.log_time, m.data)
+    assert readers.detect_format(tmp_path / "bag") == "ros-bag"
+    from_sqlite = readers.read_trace(tmp_path / "bag")
+    assert_same(trace, from_sqlite)
+    assert from_sqlite.states.equals(readers.read_trace(mcap).states)

@@ -135,7 +135,7 @@ def detect_format(path: str | Path) -> str:
             return "av2-sensor"
         if any(path.glob("scenario_*.parquet")):
             return "av2-forecasting"
-        if (path / "metadata.yaml").is_file() and any(path.glob("*.mcap")):
+        if (path / "metadata.yaml").is_file() and (any(path.glob("*.mcap")) or any(path.glob("*.db3"))):
             return "ros-bag"
         if module("trace-folder").trace_files(path):
             return "trace-folder"

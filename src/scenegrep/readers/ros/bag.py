@@ -1,5 +1,6 @@
 """Bag files to raw messages: MCAP files (read as a stream, in file order) and ROS 2 bag
-directories (``metadata.yaml`` with ``.mcap`` storage files, read in their numbers' order).
+directories (``metadata.yaml`` with ``.mcap`` storage files, read in their numbers' order, or
+``.db3`` SQLite files, read with ``rosbags``).
 
 Records are bounded before they are read: a record or a chunk's stated uncompressed size over
 :data:`MAX_RECORD_BYTES` is refused; a file that ends early is a :class:`UserError` naming the
@@ -18,7 +19,7 @@ from mcap.exceptions import McapError
 from mcap.records import Channel, Chunk, Message, Schema
 from mcap.stream_reader import StreamReader, breakup_chunk
 
-from ...errors import UserError, at
+from ...errors import UserError, at, first_line
 from .messages import RawMessage
 
 MAX_RECORD_BYTES = 1 << 30
@@ -32,11 +33,6 @@ class _Topic:
     topic: str
     schema: Schema | None
     encoding: str
-
-
-def is_bag_directory(path: Path) -> bool:
-    """Whether ``path`` is a ROS 2 bag directory (``metadata.yaml`` and storage files)."""
-    return (path / "metadata.yaml").is_file() and any(path.glob("*.mcap"))
 
 
 def storage_files(path: Path) -> list[Path]:
@@ -98,10 +94,50 @@ def messages(stream: BinaryIO, source: str) -> Iterator[RawMessage]:
 
 
 def bag_messages(path: str | Path) -> Iterator[RawMessage]:
-    """Every message of an MCAP file or a ROS 2 bag directory, file after file."""
-    for file in storage_files(Path(path)):
+    """Every message of an MCAP file or a ROS 2 bag directory, file after file (a directory of
+    ``.db3`` files through :func:`sqlite_messages`)."""
+    path = Path(path)
+    if path.is_dir() and not any(path.glob("*.mcap")):
+        yield from sqlite_messages(path)
+        return
+    for file in storage_files(path):
         with open(file, "rb") as handle:
             yield from messages(handle, str(file))
+
+
+def sqlite_messages(path: Path) -> Iterator[RawMessage]:
+    """The messages of a ROS 2 bag directory of SQLite (``.db3``) files, read with ``rosbags``
+    in log time order. The bag must store its message definitions (rosbag2 bags of format 8 and
+    later do); one without is a :class:`UserError`."""
+    from rosbags.interfaces import MessageDefinitionFormat
+    from rosbags.rosbag2 import Reader
+    from rosbags.rosbag2.errors import ReaderError
+
+    last: RawMessage | None = None
+    try:
+        with Reader(path) as reader:
+            for connection, log_time, data in reader.messages():
+                definition = connection.msgdef
+                if definition.format != MessageDefinitionFormat.MSG or not definition.data:
+                    raise UserError(
+                        f"topic {connection.topic}: the bag stores no .msg definition of {connection.msgtype}"
+                        " (rosbag2 bags before format 8 do not; record it again, or as MCAP)",
+                        at(path),
+                    )
+                encoding = getattr(connection.ext, "serialization_format", "cdr")
+                last = RawMessage(
+                    connection.topic,
+                    connection.msgtype,
+                    "ros2msg",
+                    definition.data.encode(),
+                    encoding,
+                    log_time,
+                    bytes(data),
+                )
+                yield last
+    except (ReaderError, OSError, ValueError, KeyError) as exc:
+        after = "" if last is None else f" after topic {last.topic}, message at log time {last.log_time} ns"
+        raise UserError(f"not a valid ROS 2 SQLite bag{after}: {first_line(exc)}", at(path)) from None
 
 
 def topic_table(path: str | Path) -> list[dict]:

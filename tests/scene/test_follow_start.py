@@ -242,10 +242,13 @@ def test_distance_parts_cut_at_step_counts_and_zero():
 
 @pytest.mark.slow
 @pytest.mark.real_data
-def test_scenic_samples_from_town01_curbs_match_with_witnesses_and_perturbations_do_not(maps_dir):
-    """Scenic 3.1.1's own scenes of examples/scenes/following_curb.scenic: each matches through
-    the inverted walk with a witness whose walk (Scenic's rule) ends at the label; moved 3 m across
-    its heading (refuted by the inverted walk) or turned by 0.3 rad, none matches."""
+@pytest.mark.parametrize("scene", ["following_curb", "following_region"])
+def test_scenic_samples_from_town01_match_with_witnesses_and_perturbations_do_not(maps_dir, scene):
+    """Scenic 3.1.1's own scenes of examples/scenes/following_curb.scenic (a start on a curb) and
+    following_region.scenic (a start in an intersection): each matches through the inverted walk
+    with a witness whose walk (Scenic's rule) ends at the label; turned by 0.3 rad none matches;
+    moved 3 m across its heading no curb scene matches (refuted by the inverted walk), and a
+    region scene that does has a witness reaching the moved label."""
     from pathlib import Path
 
     from scenegrep.readers.opendrive import read_map
@@ -255,26 +258,35 @@ def test_scenic_samples_from_town01_curbs_match_with_witnesses_and_perturbations
     from scenegrep.synth.ground_truth import perturbed
     from scenegrep.synth.scenic_scenes import sample_scenes
 
-    program = Path(__file__).resolve().parents[2] / "examples" / "scenes" / "following_curb.scenic"
+    program = Path(__file__).resolve().parents[2] / "examples" / "scenes" / f"{scene}.scenic"
     town = maps_dir / "Town01.xodr"
     trace = sample_scenes(program, 12, map_path=town, seed=5)  # benchmarks/bench_follow.py: 30
     road_map = read_map(town)
     geometry = geometry_of(road_map)
-    scene = load_scene(program)
+    query = load_scene(program)
     options = SceneOptions(Tolerance(), correspondence={"ego": "ego", "otherCar": "obj1"})
-    result = scene.match(trace, road_map, options)
+    car = trace.states.object == trace.object_index("obj1")
+
+    def witnesses_reach_labels(result, labels) -> None:
+        for frame in np.flatnonzero(result.matched):
+            values = result.values(frame)
+            distance = next(v for k, v in values.items() if k.startswith("Range"))
+            x, y = next(
+                v for k, v in values.items() if k.startswith(("point on: on curb", "point on: on intersection"))
+            )
+            end_x, end_y = walk_end(geometry, FIELD, [x], [y], [distance], None)
+            row = np.flatnonzero(car & (labels.states.frame == frame))[0]
+            assert abs(end_x[0] - labels.states.x[row]) <= 1e-6 and abs(end_y[0] - labels.states.y[row]) <= 1e-6
+
+    result = query.match(trace, road_map, options)
     assert result.matched.all()
     assert result.matches.notes["follow-start:sat"] == trace.n_frames
-    car = trace.states.object == trace.object_index("obj1")
-    for frame in range(trace.n_frames):
-        values = result.values(frame)
-        distance = values["Range(-30, -20)@7:58"]
-        x, y = values["point on: on curb@6:26"]
-        end_x, end_y = walk_end(geometry, FIELD, [x], [y], [distance], None)
-        row = np.flatnonzero(car & (trace.states.frame == frame))[0]
-        assert abs(end_x[0] - trace.states.x[row]) <= 1e-6 and abs(end_y[0] - trace.states.y[row]) <= 1e-6
-    moved = scene.match(perturbed(trace, "obj1", "lateral", 3.0), road_map, options)
-    assert not moved.matched.any()
-    assert moved.matches.notes["follow-start:unsat"] == trace.n_frames
-    turned = scene.match(perturbed(trace, "obj1", "heading", 0.3), road_map, options)
+    witnesses_reach_labels(result, trace)
+    moved_trace = perturbed(trace, "obj1", "lateral", 3.0)
+    moved = query.match(moved_trace, road_map, options)
+    if scene == "following_curb":
+        assert not moved.matched.any()
+        assert moved.matches.notes["follow-start:unsat"] == trace.n_frames
+    witnesses_reach_labels(moved, moved_trace)
+    turned = query.match(perturbed(trace, "obj1", "heading", 0.3), road_map, options)
     assert not turned.matched.any()

@@ -22,6 +22,12 @@ the lane from its centreline) plus the widest gap of an intersection area outsid
 candidate is also dropped when p_k's segment stays farther than that from every segment with its
 heading (no point of that segment can take it).
 
+Exact up to that reading at midpoints: of 360 random Town01 walks of 20-30 m backwards from lane
+points, the start and distance of one were missing from the preimage of its end (the heading
+changes inside a cut there). Cuts are only made where the heading may change to or from the one
+tried: a centreline vertex line changes it only between its two segments' headings, a tie only
+between its pair's.
+
 With ``check_first=False`` the first heading h_0 is not checked against the field along X's
 segment: the caller checks it at the start it picks (a start on a curb lies on the linework, where
 the heading read inside a sub-interval need not be the one at the start itself).
@@ -279,7 +285,12 @@ def _within(ex, ey, b: _Back, branch, heading, near, roads) -> tuple[np.ndarray,
     if near is None:
         off = ~shapely.covered_by(shapely.linestrings(np.stack([p, q], axis=1)), roads)
         return np.where(off, lo, np.inf), np.where(off, hi, -np.inf)
-    t_lo, t_hi = _stadium(p, q - p, near[0][:, :2], near[0][:, 2:], near[1])
+    ends, reach = near
+    low = np.minimum(ends[:, :2], ends[:, 2:]) - reach[:, None]
+    high = np.maximum(ends[:, :2], ends[:, 2:]) + reach[:, None]
+    meet = np.flatnonzero(np.all((np.minimum(p, q) <= high) & (np.maximum(p, q) >= low), axis=1))
+    t_lo, t_hi = np.full(len(p), np.inf), np.full(len(p), -np.inf)
+    t_lo[meet], t_hi[meet] = _stadium(p[meet], (q - p)[meet], ends[meet, :2], ends[meet, 2:], reach[meet])
     return np.where(t_lo <= t_hi, lo + t_lo * (hi - lo), np.inf), lo + t_hi * (hi - lo)
 
 

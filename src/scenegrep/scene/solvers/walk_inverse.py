@@ -29,9 +29,11 @@ meets the domain but no witness passes the check, or when the box is wider.
 
 Speed (Town01, ``benchmarks/bench_follow.py``: 30 Scenic scenes per start, CPU ms per one-frame
 match, median / p95; refuted = the frames moved 3 m or turned 0.3 rad; same run's known start:
-4.8 / 9.9 matched): curb starts 18.4 / 30 matched, 11.2 / 27 refuted (before, with the forward
-enumeration of :mod:`.walk_start` alone: 105 median / 650 max matched, about 1.5 s refuted);
-region starts 26 / 93 matched, 10.4 / 63 refuted (before: the general solvers, no witness).
+4.8 / 9.0 matched, 3.6 / 7.9 refuted): curb starts 15.8 / 26 matched, 9.3 / 29 refuted (before,
+with the forward enumeration of :mod:`.walk_start` alone: 105 median / 650 max matched, about
+1.5 s refuted); region starts 28 / 107 matched, 14 / 75 refuted (before: the general solvers,
+without a witness). An earlier run (before a cheaper candidate search) gave medians of 18 / 11
+(curb) and 26 / 10 (region): the machine was shared, so these vary by about a fifth.
 """
 
 from __future__ import annotations

@@ -322,3 +322,29 @@ def test_a_sqlite_bag_directory_reads_as_the_same_messages_in_mcap(short, tmp_pa
     from_sqlite = readers.read_trace(tmp_path / "bag")
     assert_same(trace, from_sqlite)
     assert from_sqlite.states.equals(readers.read_trace(mcap).states)
+
+
+@pytest.mark.parametrize(
+    ("patch", "reason"),
+    [
+        (lambda data: b"\x00\x00" + data[2:], "big-endian CDR"),
+        (lambda data: data[:28] + b"\xff\xff\xff\x7f" + data[32:], "objects (count too large)"),
+        (lambda data: data[:12] + b"\xff\xff\xff\xff" + data[16:], "header.frame_id (length too large)"),
+    ],
+    ids=["endianness", "object count", "frame id length"],
+)
+def test_hostile_counts_are_refused_before_anything_is_sized_by_them(short, tmp_path, patch, reason):
+    """A sequence count or string length past the message's bytes (each element takes one byte
+    at least) is an error before any array is sized by it; so is big-endian CDR."""
+    trace, folder = short
+    path = folder / "hostile.mcap"
+    if not path.exists():
+        write_tracked(trace, path, ORIGIN)
+    messages = list(bag_messages(path))
+    target = next(i for i, m in enumerate(messages) if m.topic == TOPIC)
+    messages[target] = messages[target]._replace(data=patch(messages[target].data))
+    _copy(messages, tmp_path / "bad.mcap")
+    with pytest.raises(UserError) as error:
+        readers.read_trace(tmp_path / "bad.mcap")
+    line = error.value.one_line()
+    assert f"topic {TOPIC}, message at log time {messages[target].log_time} ns" in line and reason in line

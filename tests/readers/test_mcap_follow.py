@@ -243,3 +243,16 @@ def test_a_followed_file_that_shrinks_is_an_error(tmp_path):
     path.write_bytes(data[:100])
     with pytest.raises(UserError, match=r"rotated\.mcap: the file shrank to fewer than the \d+ bytes read"):
         list(stream)
+
+
+def test_batches_group_what_had_arrived_together(monkeypatch):
+    """Standard input cut at every record's end, read piece by piece: each batch is the messages of
+    one piece (a caught-up reader gets each message alone); given whole, the messages in batches of
+    at most ``limit``."""
+    data = mcap_bytes(count=10, compression="unchunked")
+    cuts = list(record_ends(data))
+    monkeypatch.setattr(sys, "stdin", SimpleNamespace(buffer=_Pieces(data, cuts)))
+    assert list(follow_mcap("-", QUICK).batches()) == [[message] for message in reference(data)]
+    monkeypatch.setattr(sys, "stdin", SimpleNamespace(buffer=_Pieces(data, [])))
+    batches = list(follow_mcap("-", QUICK).batches(limit=4))
+    assert [len(batch) for batch in batches] == [4, 4, 2] and sum(batches, []) == reference(data)

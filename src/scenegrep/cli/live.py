@@ -144,7 +144,7 @@ def mcap_chunks(path: str, args: argparse.Namespace, stdin: BinaryIO | None = No
     messages = follow_mcap(path, FollowOptions(idle_timeout=args.idle_timeout), stdin)
     latency = Latency(lambda: messages.arrival, args.latency)
     name = "stdin" if path == "-" else Path(path).stem
-    chunks = live_chunks(messages, name, TraceSource(messages.name, "ros-bag"), _note)
+    chunks = live_chunks(messages.batches(), name, TraceSource(messages.name, "ros-bag"), _note)
     return latency.chunks(chunks), latency
 
 

@@ -21,8 +21,10 @@ live writer that wants each message seen at once writes unchunked, as ``ros2 bag
 * Errors (not MCAP, truncated, malformed records, unknown compression, a message on a channel never
   declared) are :class:`~scenegrep.errors.UserError` naming the input and the record's byte offset.
 
-:attr:`MessageStream.arrival` is the :func:`time.perf_counter` time at which the last message handed
-out was read: the start of a frame's online latency.
+:meth:`MessageStream.batches` groups the messages that had arrived together (one at a time while the
+reader keeps up, in bulk while it catches up). :attr:`MessageStream.arrival` is the
+:func:`time.perf_counter` time at which the last message handed out was read: the start of a
+frame's online latency.
 """
 
 from __future__ import annotations
@@ -45,6 +47,8 @@ POLL_SECONDS = 0.01
 of ~100 empty reads a second while the writer is idle."""
 MAX_RECORD_BYTES = 256 * 2**20
 READ_BLOCK = 2**20
+BATCH_MESSAGES = 4096
+"""The most messages :meth:`MessageStream.batches` hands out together."""
 
 _HEADER = struct.Struct("<BQ")
 _MESSAGE = struct.Struct("<HIQQ")
@@ -91,9 +95,12 @@ class _Source:
         self.name = name
         self.grown = time.monotonic()
         self.position = 0
+        self.caught_up = False
+        """Whether the last read got less than it asked for: nothing more had arrived then."""
 
     def read(self, size: int) -> bytes | None:
         data = self.stream.read(size) if self.follow else self.stream.read1(size)  # type: ignore[attr-defined]
+        self.caught_up = len(data) < size
         if data:
             self.grown = time.monotonic()
             self.position += len(data)
@@ -122,6 +129,24 @@ class MessageStream:
         self._channels: dict[int, tuple[str, str, int]] = {}
 
     def __iter__(self) -> Iterator[RawMessage]:
+        return (message for message in self._items() if message is not None)
+
+    def batches(self, limit: int = BATCH_MESSAGES) -> Iterator[list[RawMessage]]:
+        """The messages in lists, each handed out once the reader has caught up with the input (the
+        next record has not wholly arrived yet) or holds ``limit`` messages: one message at a time
+        while the reader keeps up with a writer, in bulk while it catches up on a backlog."""
+        batch: list[RawMessage] = []
+        for message in self._items():
+            if message is not None:
+                batch.append(message)
+            if batch and (message is None or len(batch) >= limit):
+                yield batch
+                batch = []
+        if batch:
+            yield batch
+
+    def _items(self) -> Iterator[RawMessage | None]:
+        """The messages, and None whenever the reader has caught up with the input."""
         if self.path == "-":
             yield from self._messages(_Source(self.stdin or sys.stdin.buffer, self.options, False, self.name))
             return
@@ -131,16 +156,21 @@ class MessageStream:
         except OSError as exc:
             raise UserError(f"cannot read: {exc.strerror}", at(self.path)) from None
 
-    def _messages(self, source: _Source) -> Iterator[RawMessage]:
+    def _messages(self, source: _Source) -> Iterator[RawMessage | None]:
         for offset, opcode, body in self._records(source):
-            if opcode in (_DATA_END, _FOOTER):
+            if body is None:
+                yield None
+            elif opcode in (_DATA_END, _FOOTER):
                 return
-            for message in self._decode(offset, opcode, body):
-                self.arrival = time.perf_counter()
-                yield message
+            else:
+                for message in self._decode(offset, opcode, body):
+                    self.arrival = time.perf_counter()
+                    yield message
 
-    def _records(self, source: _Source) -> Iterator[tuple[int, int, memoryview]]:
-        """(byte offset, opcode, body) of each whole top-level record after the magic."""
+    def _records(self, source: _Source) -> Iterator[tuple[int, int, memoryview | None]]:
+        """(byte offset, opcode, body) of each whole top-level record after the magic; the body is
+        None (a mark, no record) when the next record has not wholly arrived and the input had no
+        more bytes at the last read."""
         buffer = bytearray()
         offset = 0
 
@@ -157,6 +187,9 @@ class MessageStream:
         del buffer[: len(MAGIC)]
         offset = len(MAGIC)
         while True:
+            whole = len(buffer) >= _HEADER.size and len(buffer) >= _HEADER.size + _HEADER.unpack_from(buffer)[1]
+            if source.caught_up and not whole:
+                yield offset, 0, None
             if not fill(_HEADER.size):
                 if buffer:
                     raise self._error(offset, None, "the stream ends inside a record's header")

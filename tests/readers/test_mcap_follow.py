@@ -91,8 +91,12 @@ def test_a_finished_file_gives_the_libraries_messages_and_ends_at_its_data_end(t
 @settings(max_examples=40, deadline=None)
 @given(st.sampled_from(["unchunked", "lz4"]), st.lists(st.integers(0, 4000), max_size=30))
 def test_standard_input_cut_anywhere_gives_the_same_messages(monkeypatch_session, compression, cuts):
+    """Messages one by one, or in batches (one per piece that completes records, at most 7): the same."""
     data = mcap_bytes(compression=compression)
     assert from_stdin(monkeypatch_session, data, cuts) == reference(data)
+    monkeypatch_session.setattr(sys, "stdin", SimpleNamespace(buffer=_Pieces(data, cuts)))
+    batches = list(follow_mcap("-", QUICK).batches(limit=7))
+    assert sum(batches, []) == reference(data) and all(0 < len(batch) <= 7 for batch in batches)
 
 
 @pytest.fixture(scope="module")

@@ -290,7 +290,10 @@ def check_round_trip(program: Path, row: dict, context: float | None, compile_fi
             for j in np.flatnonzero(same):
                 if ids[s.object[j]] in anchors and math.hypot(s.x[i] - s.x[j], s.y[i] - s.y[j]) <= context:
                     expected.add(ids[s.object[i]])
-    scene = scene_of(compile_file(program))
+    speeds = program.with_name(program.stem + "-speeds.scenic")
+    names = re.findall(r"^(\w+) = new ", program.read_text(), re.MULTILINE)
+    speeds.write_text(program.read_text() + "".join(f"record {n}.speed as {n}\n" for n in names))
+    scene = scene_of(compile_file(speeds))
     assert sorted(o.name for o in scene.objects) == sorted(expected)
     assert scene.egoObject.name == json.loads(row["correspondence"]).get("ego", trace.ego)
     period = float(np.median(np.diff(trace.frame_time)))
@@ -311,7 +314,20 @@ def check_round_trip(program: Path, row: dict, context: float | None, compile_fi
     trajectory = simulation.result.trajectory
     assert len(trajectory) == len(window)  # the program ends with the window
     error = 0.0
-    for j, obj in enumerate(scene.objects):
+    times = trace.frame_time[window] - trace.frame_time[window[0]]
+    steps = np.arange(len(window)) * period
+    for j, (obj, name) in enumerate(zip(scene.objects, names)):
+        k = np.flatnonzero(in_window & (s.object == ids.index(obj.name)))
+        seen = times[np.searchsorted(window, s.frame[k])]
+        x, y = np.interp(steps, seen, s.x[k]), np.interp(steps, seen, s.y[k])
+        expected = np.hypot(np.diff(x), np.diff(y)) / period  # the recording's finite-difference speeds
+        first = (
+            math.hypot(s.x[k[1]] - s.x[k[0]], s.y[k[1]] - s.y[k[0]]) / (seen[1] - seen[0])
+            if seen[0] == 0 and len(k) > 1
+            else 0.0
+        )
+        simulated = [speed for _, speed in simulation.result.records[name]]
+        np.testing.assert_allclose(simulated, [first, *expected], rtol=1e-9, atol=1e-6)
         for step, position in enumerate(window):
             here = np.flatnonzero((s.frame == position) & (s.object == ids.index(obj.name)))
             if len(here):

@@ -6,11 +6,18 @@ corresponds to, else the trace's ego, else the first, is Scenic's ``ego``) of th
 canonical kind (:data:`SCENIC_CLASSES`), at its first labeled position and heading, with its
 labeled size (a size the labels do not give is left to the class's default), and with the
 behaviour ``FollowRecording``, which at every simulation step takes an action putting the
-object at its recorded pose for the end of the step: the labeled positions and headings as
-literals (``repr`` of each float, so the values are the labels' bit for bit), linear between
-observations (headings the short way round), held before the first and after the last. The
-Newtonian physics then moves nothing (every object's velocity stays 0), so a simulation with
-any timestep follows the recording up to rounding. ``terminate when`` ends it when the
+object at its recorded pose for the start of the step and giving it the velocity (m/s) and
+angular speed (rad/s) that take it to its recorded pose for the end of the step: the labeled
+positions and headings as literals (``repr`` of each float, so the values are the labels' bit
+for bit), linear between observations (headings the short way round), held before the first
+and after the last (velocity 0 there). Each object starts with the velocity of its first
+recorded segment. The Newtonian physics integrates ``position += velocity * dt``, so an object
+that is not a car lands on its recording at every step, with its recorded finite-difference
+velocity and speed. The simulator drives a car (``isCar``, the driving model's vehicles) along
+its heading at its current speed: a car gets its recorded speed (forward or in reverse), moves
+along its heading during a step and is put back on its recording at the next, so its
+positions stray by at most its side-slip over one step and the error does not accumulate.
+``terminate when`` ends the simulation when the
 window's duration has passed (rounded to whole steps).
 
 The map: an OpenDRIVE map (a trace's ``map_source`` of format ``opendrive`` naming a file) is
@@ -89,21 +96,26 @@ def recordedPose(path, times, time):
     turn = (h1 - h0 + math.pi) % math.tau - math.pi
     return x0 + a * (x1 - x0), y0 + a * (y1 - y0), h0 + a * turn
 
-class SetRecordedPose(Action):
-    """Puts the agent at a pose (x, y, heading) for the next simulation step."""
-    def __init__(self, pose):
-        self.pose = pose
+class SetRecordedMotion(Action):
+    """Puts the agent at the pose (x, y, heading) `start` with the velocity (m/s) and angular
+    speed (rad/s) that take it to the pose `end` in `dt` s."""
+    def __init__(self, start, end, dt):
+        self.start, self.end, self.dt = start, end, dt
     def applyTo(self, obj, sim):
-        x, y, heading = self.pose
-        obj.position = Vector(x, y)
-        obj.heading = heading
+        (x0, y0, h0), (x1, y1, h1) = self.start, self.end
+        obj.position = Vector(x0, y0)
+        obj.heading = h0
+        obj.velocity = Vector((x1 - x0) / self.dt, (y1 - y0) / self.dt)
+        obj.speed = math.hypot(x1 - x0, y1 - y0) / self.dt
+        obj.angularSpeed = ((h1 - h0 + math.pi) % math.tau - math.pi) / self.dt
 
 behavior FollowRecording(path):
-    """At every step, the recorded pose for the end of the step."""
+    """At every step, the recorded pose for the start of the step and the motion to its end."""
     times = [row[0] for row in path]
     while True:
-        end = (simulation().currentTime + 1) * simulation().timestep
-        take SetRecordedPose(recordedPose(path, times, end))
+        dt = simulation().timestep
+        now = simulation().currentTime * dt
+        take SetRecordedMotion(recordedPose(path, times, now), recordedPose(path, times, now + dt), dt)
 '''
 
 
@@ -203,7 +215,8 @@ def _header(moment: Moment, map_reference: str | None, without_map: str | None) 
         f"# Scenic {SCENIC_VERSION}, 2-D mode (scenic --2d -S FILE; mode2D=True in Python): each object starts at its",
         "# labeled pose and follows its recorded path (positions in the map frame, m; headings in rad,",
         "# 0 along +y, counter-clockwise), linear between frames; elevations are not exported.",
-        "# Objects move by taking their pose at every step: their speeds in the simulation stay 0.",
+        "# Every step puts each object at its recorded pose and gives it the velocity to its next one (cars",
+        "# move along their heading at that speed).",
     ]
     if map_reference is None:
         lines += [
@@ -240,7 +253,10 @@ def _object(path: ObjectPath, name: str, cls: str) -> list[str]:
             specifiers.append(f"with {prop} {_number(value)}")
         else:
             unknown.append(prop)
+    vx, vy = _first_velocity(path)
     specifiers += [
+        f"with velocity {_number(vx)} @ {_number(vy)}",
+        f"with speed {_number(math.hypot(vx, vy))}",
         f"with name {path.label_id!r}",
         "with allowCollisions True",
         "with requireVisible False",
@@ -260,6 +276,15 @@ def _object(path: ObjectPath, name: str, cls: str) -> list[str]:
         "",
     ]
     return lines
+
+
+def _first_velocity(path: ObjectPath) -> tuple[float, float]:
+    """The velocity (m/s) of the path's first segment; (0, 0) for a path of one observation or one
+    first observed after the window's first frame (held until then)."""
+    if len(path.times) < 2 or path.times[0] != 0 or not path.times[1] > path.times[0]:
+        return 0.0, 0.0
+    dt = float(path.times[1] - path.times[0])
+    return float(path.x[1] - path.x[0]) / dt, float(path.y[1] - path.y[0]) / dt
 
 
 def _number(value: float) -> str:

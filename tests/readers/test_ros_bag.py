@@ -348,3 +348,25 @@ def test_hostile_counts_are_refused_before_anything_is_sized_by_them(short, tmp_
         readers.read_trace(tmp_path / "bad.mcap")
     line = error.value.one_line()
     assert f"topic {TOPIC}, message at log time {messages[target].log_time} ns" in line and reason in line
+
+
+def test_frame_topic_and_topics_choose_the_frames_and_the_boxes(short, tmp_path):
+    """Two box topics of the same frames: each frame of ``--frame-topic`` holds both topics'
+    boxes (the other topic's latest message at or before it); ``--topics`` reads only those named.
+    (An id given on two topics is one object: its first row in a frame is kept.)"""
+    trace, folder = short
+    detected = "/perception/object_recognition/detection/objects"
+    write_tracked(trace, tmp_path / "tracked.mcap", ORIGIN)
+    write_tracked(trace, tmp_path / "detected.mcap", ORIGIN, box_type="autoware_perception_msgs/DetectedObjects")
+    second = [m for m in bag_messages(tmp_path / "detected.mcap") if m.topic != "/tf"]
+    both = sorted([*bag_messages(tmp_path / "tracked.mcap"), *second], key=lambda m: m.log_time)
+    _copy(both, tmp_path / "both.mcap")
+    framed = read_trace(tmp_path / "both.mcap", BagOptions(frame_topic=detected))
+    assert framed.n_frames == trace.n_frames
+    observations = len(trace.states) - trace.n_frames  # without the ego's
+    assert framed.n_objects == (trace.n_objects - 1) + observations + 1  # UUIDs, one id per detection, the ego
+    assert len(framed.states) == 2 * observations + trace.n_frames
+    only = read_trace(tmp_path / "both.mcap", BagOptions(topics=(TOPIC,)))
+    assert_same(trace, only)
+    with pytest.raises(UserError, match="give --rate or --frame-topic, not both"):
+        BagOptions(rate=2.0, frame_topic=TOPIC)

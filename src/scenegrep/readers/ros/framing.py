@@ -21,6 +21,11 @@ arrives after the boxes it places is waited for; frames are emitted in stamp ord
 message stamped at or before a frame already emitted arrives too late and is dropped (counted
 in :attr:`FrameBuilder.late`).
 
+**Objects.** A box's object is its id; the same id on two topics is one object, and when a
+frame holds it twice the first row is kept (topics in the order their first batch arrived).
+Objects are numbered in order of first appearance, so the chunks of a run concatenate to the
+trace of one chunk.
+
 **Map frame.** Boxes are moved into ``map_frame`` with the transform at their header stamp
 (:class:`TfBuffer`: linear in translation, slerp in rotation); the ego (object ``ego``) is
 ``ego_frame``'s pose in the map frame at the frame's stamp, when ``ego_frame`` reaches the map

@@ -3,8 +3,8 @@
 :func:`follow_mcap` yields :class:`RawMessage` tuples (topic, schema name, encoding and data, message
 encoding, log time in ns, payload) in the stream's record order, each as soon as the record that carries
 it has wholly arrived: a Message record, or for messages inside a Chunk record the whole chunk (a
-live writer that wants each message seen at once writes unchunked, as ``ros2 bag record``'s
-``fastwrite`` preset does, or small chunks).
+live writer that wants each message seen at once writes unchunked, e.g. ``noChunking: true`` in the
+storage configuration of ``ros2 bag record -s mcap``, or small chunks).
 
 * Records are framed by their own prefix (opcode: 1 byte, length: 8 bytes, little-endian) and parsed
   only once all their bytes are there, so a half-written record is never read; a file is read from

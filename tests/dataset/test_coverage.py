@@ -148,7 +148,8 @@ def test_default_positions_of_several_objects_get_distinct_names():
 def outputs(tmp_path_factory):
     folder = tmp_path_factory.mktemp("coverage")
     argv = ["coverage", str(FIG3), *map(str, FILES), *TOLERANCES, "--bins", "6"]
-    code = main([*argv, "-o", str(folder / "c.parquet"), "--html", str(folder / "page.html"), "-q"])
+    pictures = ["--html", str(folder / "page.html"), "--png", str(folder / "plots.png")]
+    code = main([*argv, "-o", str(folder / "c.parquet"), *pictures, "-q"])
     code_json = main([*argv, "-o", str(folder / "c.json"), "-q"])
     return folder, code, code_json
 
@@ -176,6 +177,31 @@ def test_page_links_each_covered_bin_to_its_matches_views(outputs):
     assert page.count('<section id="bin-') == len(covered)
     views = sorted(p.name for p in (folder / "page_views").iterdir())
     assert views and all(f"page_views/{name}#match=" in page for name in views)
+
+
+def test_png_draws_a_bar_per_covered_bin_and_a_red_stripe_per_gap(outputs):
+    from matplotlib.image import imread
+
+    from scenegrep.view.charts import GAP_COLOUR
+    from scenegrep.view.coverage_png import coverage_figure
+
+    values = [
+        _range(lo, lo) | {"e": {"kind": "range", "lo": e, "hi": e}} for lo, e in [(2.5, 0.1), (2.6, 0.9), (7, 0.1)]
+    ]
+    other = Declared("e", "range", 4, 0.0, 1.0)
+    coverage = coverage_of(_rows([*values, _range(3.9, 4.1), {}]), [RANGE, other], 5)
+    first, second, pair = coverage_figure(coverage).axes
+    bars, gaps = first.containers
+    assert [(round(b.get_x() + b.get_width() / 2), b.get_height()) for b in bars] == [(0, 2), (2, 1)]
+    assert [round(b.get_x() + b.get_width() / 2) for b in gaps] == [1, 3, 4]
+    assert "2 of 5 bins covered, 1 ambiguous, 1 without a value" in first.get_title(loc="left")
+    assert [b.get_height() for b in second.containers[0]] == [2, 1]
+    assert pair.get_images()[0].get_array().tolist() == coverage.joint(0, 1).tolist()
+    folder, _, _ = outputs
+    pixels = imread(folder / "plots.png")[:, :, :3]
+    red = np.array([int(GAP_COLOUR[i : i + 2], 16) / 255 for i in (1, 3, 5)])
+    table = pq.read_table(folder / "c.parquet").to_pylist()
+    assert any(r["gap"] for r in table) == bool((np.abs(pixels - red).max(axis=2) < 0.02).any())
 
 
 def test_summary_names_gaps_and_ambiguous_matches(capsys):
@@ -263,6 +289,7 @@ def test_scenario_coverage_is_that_of_the_initial_scenes(tmp_path):
         (["--bins", str(MAX_BINS + 1)], "--bins must be between 1"),
         (["-o", "table.csv"], "a .parquet or .json file"),
         (["--html", "page.pdf"], "an .html file"),
+        (["--png", "plots.svg"], "a .png file"),
         (["--window", "0"], "at least one frame"),
     ],
 )

@@ -7,7 +7,8 @@ or over a dataset. For every match, the values of each random variable that repr
 (:mod:`scenegrep.dataset.coverage`). Output: a text summary on stdout (per variable the matches
 per bin, the gaps and the ambiguous matches, the joint coverage of pairs, per source);
 ``--output`` the coverage table (Parquet or JSON); ``--html`` a page of the plots whose bins
-link to their matches' views. Exit codes: 0 some match, 1 none, 2 error, 3 some trace failed.
+link to their matches' views; ``--png`` the plots as one picture (:mod:`scenegrep.view.coverage_png`).
+Exit codes: 0 some match, 1 none, 2 error, 3 some trace failed.
 """
 
 from __future__ import annotations
@@ -45,6 +46,7 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("-o", "--output", metavar="FILE", help="write the coverage table (.parquet or .json)")
     parser.add_argument("--html", metavar="PAGE", help="write the page of plots (.html) and the matches' views")
+    parser.add_argument("--png", metavar="FILE", help="write the plots as one picture (.png)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
     add_dataset_arguments(parser, results_table=False)
     parser.set_defaults(run=run)
@@ -62,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
         check_output(args.output)
     if args.html and Path(args.html).suffix.lower() != ".html":
         raise UserError(f"--html {args.html}: the page is an .html file")
+    if args.png and Path(args.png).suffix.lower() != ".png":
+        raise UserError(f"--png {args.png}: the picture is a .png file")
     options: dict[str, Any] = {"visible_distance": args.visible_distance, "intervals": True, **tolerance_options(args)}
     if args.window is not None:
         options |= {"window": args.window, "all": True}
@@ -77,6 +81,10 @@ def run(args: argparse.Namespace) -> int:
 
         root = Path(args.dataset).resolve() if args.dataset else None
         write_coverage_page(ResultsSource.of_results(results, root), coverage, args.html)
+    if args.png:
+        from ..view.coverage_png import write_coverage_png
+
+        write_coverage_png(coverage, args.png)
     if not args.quiet:
         print(summary_text(coverage, args.program))
     counts = results.counts()

@@ -31,5 +31,6 @@ def test_sampled_scenes_match_and_violations_do_not(program, maps_dir):
     result = check_program(program, SCENES, maps_dir / "Town01.xodr", seed=7, random_perturbations=False)
     assert result.scenes == SCENES
     assert result.false_negatives == 0
+    assert result.random_rejected == (0, 0)  # not asked for: not computed
     for violation, (rejected, total) in result.violations.items():
         assert rejected == total, violation

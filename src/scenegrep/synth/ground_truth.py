@@ -100,9 +100,8 @@ def check_program(
         changed = perturbed(trace, names[obj], feature, amount)
         rejected = int((~query.match(changed, None, options).matched).sum())
         violations[f"{obj} {feature} {amount:+g}"] = (rejected, trace.n_frames)
-    return GroundTruth(
-        program.name, trace.n_frames, matched, violations, _random_rejections(query, trace, options, seed)
-    )
+    random_rejected = _random_rejections(query, trace, options, seed) if random_perturbations else (0, 0)
+    return GroundTruth(program.name, trace.n_frames, matched, violations, random_rejected)
 
 
 def _label_names(query, trace: LabelTrace) -> dict[str, str]:

@@ -204,6 +204,17 @@ def test_png_draws_a_bar_per_covered_bin_and_a_red_stripe_per_gap(outputs):
     assert any(r["gap"] for r in table) == bool((np.abs(pixels - red).max(axis=2) < 0.02).any())
 
 
+def test_a_failed_trace_makes_uncovered_bins_unknown_not_gaps(tmp_path, capsys):
+    (tmp_path / "bad.parquet").write_text("not parquet")
+    argv = ["coverage", str(FIG3), str(FILES[0]), str(tmp_path / "bad.parquet"), *TOLERANCES, "--bins", "6"]
+    assert main([*argv, "-o", str(tmp_path / "c.json"), "--png", str(tmp_path / "c.png")]) == 3
+    out = capsys.readouterr().out
+    assert "unknown: 1 trace failed" in out and "uncovered in the data decided:" in out and "gaps:" not in out
+    table = json.loads((tmp_path / "c.json").read_text())
+    assert {r["gap"] for r in table if r["matches"] == 0} == {None}
+    assert {r["gap"] for r in table if r["matches"]} == {False}
+
+
 def test_summary_names_gaps_and_ambiguous_matches(capsys):
     code = main(["coverage", str(FIG3), str(FILES[0]), *TOLERANCES, "--bins", "3"])
     out = capsys.readouterr().out
@@ -290,10 +301,15 @@ def test_scenario_coverage_is_that_of_the_initial_scenes(tmp_path):
         (["-o", "table.csv"], "a .parquet or .json file"),
         (["--html", "page.pdf"], "an .html file"),
         (["--png", "plots.svg"], "a .png file"),
+        (["--png", "folder.png"], "a directory"),
+        (["-o", "folder.json"], "a directory"),
         (["--window", "0"], "at least one frame"),
     ],
 )
-def test_bad_options_are_user_errors(extra, message, capsys, tmp_path):
+def test_bad_options_are_user_errors(extra, message, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "folder.png").mkdir()
+    (tmp_path / "folder.json").mkdir()
     code = main(["coverage", str(FIG3), str(FILES[0]), *extra])
     assert code == 2
     assert message in capsys.readouterr().err

@@ -54,7 +54,7 @@ def add_parser(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..dataset import QuerySpec
-    from ..dataset.coverage import checked_bins, check_output, coverage_of, variables_of
+    from ..dataset.coverage import checked_bins, check_output, coverage_of, unknown_data, variables_of
     from ..dataset.coverage_text import summary_text
     from ..errors import UserError
     from ..scenic.parser import read_program
@@ -66,13 +66,16 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--html {args.html}: the page is an .html file")
     if args.png and Path(args.png).suffix.lower() != ".png":
         raise UserError(f"--png {args.png}: the picture is a .png file")
+    for option, path in (("--output", args.output), ("--html", args.html), ("--png", args.png)):
+        if path and Path(path).is_dir():
+            raise UserError(f"{option} {path}: a directory; name the file to write")
     options: dict[str, Any] = {"visible_distance": args.visible_distance, "intervals": True, **tolerance_options(args)}
     if args.window is not None:
         options |= {"window": args.window, "all": True}
     kind = "scene" if args.window is None else "scenario"
     spec = QuerySpec.of(kind, read_program(args.program), args.program, **options)
     results, _ = results_of(args, spec, args.data, RowPrinter(args, failures_only=True))
-    coverage = coverage_of(results.matches.to_pylist(), variables_of(spec), bins)
+    coverage = coverage_of(results.matches.to_pylist(), variables_of(spec), bins, unknown_data(results))
     if args.output:
         coverage.write(args.output)
     if args.html:

@@ -17,6 +17,10 @@ counts as ambiguous for that variable; an ``Options`` value covers its alternati
 one alternative alone reproduces the frame. Bins no match covers are *gaps*. Two axes' joint
 coverage counts the matches that cover one bin of each. Each axis's bins are also broken down by
 the results' ``source`` (the input file or the ingested source).
+
+Data the run did not decide (failed traces, the traces an interrupted run did not reach) may
+hold matches anywhere: a coverage with ``unknown`` set (the sentence saying which data) reports
+no bin as a gap: an uncovered bin's ``gap`` is null ("not covered in the data decided").
 """
 
 from __future__ import annotations
@@ -66,7 +70,7 @@ TABLE_SCHEMA = pa.schema(
 """The coverage table: one row per bin of each axis (``variable2`` null) and per cell of each
 pair of axes (:meth:`Coverage.pairs`), over all sources (``source`` null), and one per bin of
 each axis that a source's matches cover (``source`` set); ``matches`` covering it, ``gap``
-when none does."""
+when none does (null when part of the data is unknown: :attr:`Coverage.unknown`)."""
 
 
 def checked_bins(bins: int) -> int:
@@ -133,13 +137,15 @@ class Coverage:
     """The coverage of one run: its ``axes``, per match row (``rows``: trace_id, name, source,
     match, start_frame, end_frame, correspondences) and axis the recovered interval (``lo``,
     ``hi``; NaN: no value) and the bin covered (``assigned``; :data:`AMBIGUOUS`,
-    :data:`NO_VALUE`)."""
+    :data:`NO_VALUE`); ``unknown`` says which data the run did not decide ("" when none), so
+    that an uncovered bin is no gap but uncovered in the data decided."""
 
     axes: list[Axis]
     rows: list[dict[str, Any]]
     lo: np.ndarray
     hi: np.ndarray
     assigned: np.ndarray
+    unknown: str = ""
 
     @property
     def sources(self) -> list[str]:
@@ -187,13 +193,24 @@ class Coverage:
                 for k, n in enumerate(self.counts(a, source).tolist()):
                     if n or source is None:
                         lo, hi = axis.bounds(k)
-                        out.append(_row(axis.name, None, source, k, None, lo, hi, None, None, axis.label(k), n))
+                        out.append(
+                            _row(axis.name, None, source, k, None, lo, hi, None, None, axis.label(k), n, self._gap(n))
+                        )
         for a, b in self.pairs():
             for (i, j), n in np.ndenumerate(self.joint(a, b)):
                 (lo, hi), (lo2, hi2) = self.axes[a].bounds(i), self.axes[b].bounds(j)
                 label = f"{self.axes[a].label(i)} × {self.axes[b].label(j)}"
-                out.append(_row(self.axes[a].name, self.axes[b].name, None, i, j, lo, hi, lo2, hi2, label, n))
+                out.append(
+                    _row(self.axes[a].name, self.axes[b].name, None, i, j, lo, hi, lo2, hi2, label, n, self._gap(n))
+                )
         return pa.Table.from_pylist(out, schema=TABLE_SCHEMA)
+
+    def _gap(self, matches: int) -> bool | None:
+        """Whether a bin (cell) covered by ``matches`` is a gap: None when it is not covered but
+        part of the data is unknown."""
+        if matches:
+            return False
+        return None if self.unknown else True
 
     def write(self, path: str) -> None:
         """The coverage table as Parquet (``.parquet``) or a JSON array of rows (``.json``), atomically."""
@@ -208,7 +225,7 @@ class Coverage:
                 tmp.write_text(json.dumps(self.table().to_pylist(), allow_nan=False), encoding="utf-8")
 
 
-def _row(variable, variable2, source, k, k2, lo, hi, lo2, hi2, label, n) -> dict[str, Any]:
+def _row(variable, variable2, source, k, k2, lo, hi, lo2, hi2, label, n, gap) -> dict[str, Any]:
     return {
         "variable": variable,
         "variable2": variable2,
@@ -221,8 +238,20 @@ def _row(variable, variable2, source, k, k2, lo, hi, lo2, hi2, label, n) -> dict
         "hi2": hi2,
         "label": label,
         "matches": int(n),
-        "gap": int(n) == 0,
+        "gap": gap,
     }
+
+
+def unknown_data(results: Any) -> str:
+    """Which data a run (:class:`~.results.Results`) did not decide, as a sentence: its failed
+    traces, and the traces it did not reach when interrupted; "" when it decided all."""
+    parts = []
+    failed = results.counts()["failed"]
+    if failed:
+        parts.append(f"{failed} trace{'s' * (failed != 1)} failed")
+    if results.status == "interrupted":
+        parts.append("the run was interrupted before every trace was queried")
+    return "; ".join(parts)
 
 
 def variables_of(spec: QuerySpec) -> list[Declared]:
@@ -232,8 +261,9 @@ def variables_of(spec: QuerySpec) -> list[Declared]:
     return declared(scene.groups)
 
 
-def coverage_of(match_rows: list[dict[str, Any]], variables: list[Declared], bins: int) -> Coverage:
-    """The coverage of the match rows of a results table (see the module docstring)."""
+def coverage_of(match_rows: list[dict[str, Any]], variables: list[Declared], bins: int, unknown: str = "") -> Coverage:
+    """The coverage of the match rows of a results table (see the module docstring); ``unknown``
+    says which data the run did not decide ("" when it decided all)."""
     bins = checked_bins(bins)
     parsed = [json.loads(r.get("intervals") or "null") or {} for r in match_rows]
     rows = [
@@ -257,7 +287,7 @@ def coverage_of(match_rows: list[dict[str, Any]], variables: list[Declared], bin
     assigned = np.full((n, len(axes)), NO_VALUE, dtype=np.int64)
     for a, (axis, (low, high, chosen)) in enumerate(zip(axes, columns)):
         assigned[:, a] = _assign(axis, low, high, chosen)
-    return Coverage(axes, rows, lo, hi, assigned)
+    return Coverage(axes, rows, lo, hi, assigned, unknown)
 
 
 def _columns(variable: Declared, values: list[dict[str, Any]]):

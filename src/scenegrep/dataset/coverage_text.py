@@ -17,6 +17,10 @@ def summary_text(coverage: Coverage, program: str) -> str:
         f"from {len(coverage.sources)} sources; {coverage.ambiguous()} ambiguous (an interval over several bins), "
         f"{coverage.several()} with several correspondences"
     ]
+    if coverage.unknown:
+        lines.append(
+            f"unknown: {coverage.unknown}; bins no match covers are not gaps there (uncovered, not known empty)"
+        )
     for a, axis in enumerate(coverage.axes):
         counts = coverage.counts(a).tolist()
         column = coverage.assigned[:, a]
@@ -28,7 +32,8 @@ def summary_text(coverage: Coverage, program: str) -> str:
             f"ambiguous {int((column == AMBIGUOUS).sum())}; without a value {int((column == NO_VALUE).sum())}"
         )
         gaps = [axis.label(k) for k, n in enumerate(counts) if not n]
-        lines.append(f"  gaps: {', '.join(gaps) if gaps else 'none'}")
+        named = "uncovered in the data decided" if coverage.unknown else "gaps"
+        lines.append(f"  {named}: {', '.join(gaps) if gaps else 'none'}")
     if coverage.pairs():
         lines.append("joint coverage (cells of two bins that one match covers):")
         for a, b in coverage.pairs():

@@ -46,6 +46,14 @@ def coverage_page(source: ResultsSource, coverage: Coverage, link: Callable[[str
         "<h1>scenegrep coverage</h1>",
         f'<pre id="query">{html.escape(f"{query.kind}: {query.text}" if query else "(query unknown)")}</pre>',
         f'<section id="summary">{_cards(coverage)}</section>',
+        *(
+            [
+                f'<p id="unknown" class="gaps">unknown: {html.escape(coverage.unknown)}; bins no match covers are '
+                "uncovered in the data decided, not known gaps</p>"
+            ]
+            if coverage.unknown
+            else []
+        ),
         "<h2>Variables</h2>",
         '<section id="charts">',
         *(_axis_figure(coverage, a) for a in range(len(coverage.axes))),
@@ -82,7 +90,8 @@ def _axis_figure(coverage: Coverage, a: int) -> str:
     caption = (
         f"{html.escape(axis.domain_text())}; {sum(1 for n in counts if n)} of {axis.bins} bins covered; "
         f"{int((column == AMBIGUOUS).sum())} ambiguous, {int((column == NO_VALUE).sum())} without a value"
-        f'<br><span class="gaps">gaps: {html.escape(", ".join(gaps) if gaps else "none")}</span>'
+        f'<br><span class="gaps">{"uncovered in the data decided" if coverage.unknown else "gaps"}: '
+        f"{html.escape(', '.join(gaps) if gaps else 'none')}</span>"
     )
     return f'<figure data-axis="{html.escape(axis.name)}">{chart}<figcaption>{caption}</figcaption></figure>'
 

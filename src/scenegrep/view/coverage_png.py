@@ -5,7 +5,9 @@ The picture holds what the coverage page (:mod:`.coverage_page`) charts, in its 
 the matches covering each bin (bar height = count), and a red stripe under every gap (a bin no
 match covers); per pair of axes a heat map of the joint counts (empty cells white). The panel
 titles give the covered bins, the ambiguous matches and those without a value, so a reader of
-the picture alone sees that unknown values are neither coverage nor gaps.
+the picture alone sees that unknown values are neither coverage nor gaps. When part of the
+data is unknown (:attr:`~scenegrep.dataset.coverage.Coverage.unknown`), the figure's title says so
+and the uncovered bins' stripes are grey (uncovered in the data decided, not known gaps).
 """
 
 from __future__ import annotations
@@ -17,6 +19,9 @@ import numpy as np
 from ..dataset.coverage import AMBIGUOUS, NO_VALUE, Coverage
 from ..writers.atomic import atomic_path
 from .charts import BAR_COLOUR, GAP_COLOUR
+
+UNKNOWN_COLOUR = "#bbbbbb"
+"""The stripe under an uncovered bin when part of the data is unknown."""
 
 PANEL_WIDTH = 6.4
 """Width (inches) of a panel; the picture is one panel wide, at 100 dpi."""
@@ -35,6 +40,9 @@ def coverage_figure(coverage: Coverage):
     panels = max(len(coverage.axes) + len(pairs), 1)
     figure = Figure(figsize=(PANEL_WIDTH, 2.6 * panels), dpi=100, layout="constrained")
     plots = figure.subplots(panels, 1, squeeze=False)[:, 0]
+    if coverage.unknown:
+        figure.suptitle(f"unknown: {coverage.unknown}; grey bins: uncovered in the data decided", fontsize=8)
+    stripes = UNKNOWN_COLOUR if coverage.unknown else GAP_COLOUR
     if not coverage.axes:
         plots[0].set_title("no random variable")
         plots[0].set_axis_off()
@@ -46,7 +54,7 @@ def coverage_figure(coverage: Coverage):
         covered = counts > 0
         plot = plots[a]
         plot.bar(bins[covered], counts[covered], width=0.9, color=BAR_COLOUR)
-        plot.bar(bins[~covered], np.full(int((~covered).sum()), stripe), width=0.9, color=GAP_COLOUR)
+        plot.bar(bins[~covered], np.full(int((~covered).sum()), stripe), width=0.9, color=stripes)
         plot.set_title(
             f"{axis.name}: {int(covered.sum())} of {axis.bins} bins covered, "
             f"{int((column == AMBIGUOUS).sum())} ambiguous, {int((column == NO_VALUE).sum())} without a value",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import uuid
+from math import cos, sin
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -321,6 +322,7 @@ def write_tracked(
     writer = BagWriter(path)
     stamps = frame_stamps(trace, origin_ns)
     topic, body = BOX_MESSAGES[box_type]
+    ego_velocity = np.column_stack([trace.dense(c)[:, trace.object_index(trace.ego)] for c in ("vx", "vy")])
     pending_tf = None
     for f, ((ego_pose, ego_yaw), boxes) in enumerate(frames_in_ego_frame(trace)):
         header = {"stamp": _stamp(int(stamps[f])), "frame_id": "map"}
@@ -333,7 +335,9 @@ def write_tracked(
             )
         else:
             pose = {"pose": {"position": ego_pose, "orientation": _quat(ego_yaw)}, "covariance": COVARIANCE}
-            twist = {"twist": {"linear": ZERO, "angular": ZERO}, "covariance": COVARIANCE}
+            vx, vy = ego_velocity[f]  # the twist is in the ego's own frame (base_link)
+            linear = {"x": cos(ego_yaw) * vx + sin(ego_yaw) * vy, "y": -sin(ego_yaw) * vx + cos(ego_yaw) * vy, "z": 0.0}
+            twist = {"twist": {"linear": linear, "angular": ZERO}, "covariance": COVARIANCE}
             message = {"header": header, "child_frame_id": "base_link", "pose": pose, "twist": twist}
             ego = (ego_topic, "nav_msgs/Odometry", message)
         log = int(stamps[f]) + 20_000_000

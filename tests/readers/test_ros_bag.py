@@ -248,7 +248,8 @@ def test_detected_objects_with_odometry_give_back_every_observation(short):
         assert np.abs(heading_difference(b.heading[at], s.heading[mine])).max() < 1e-9
         assert bag.objects.kinds()[theirs].tolist() == trace.objects.kinds()[s.object[mine]].tolist()
     ego_rows = b.object == rows["ego"]
-    np.testing.assert_allclose(b.x[ego_rows], s.x[s.object == ego], atol=1e-6)
+    for column in ("x", "y", "vx", "vy"):  # odometry gives the ego's twist too
+        np.testing.assert_allclose(getattr(b, column)[ego_rows], getattr(s, column)[s.object == ego], atol=1e-6)
     assert bag.n_objects == np.sum(s.object != ego) + 1
 
 

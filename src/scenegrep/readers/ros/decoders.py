@@ -19,7 +19,7 @@ field order or added field of a message version is read right). Supported types 
   empty); the image size is not in the message (unknown);
 - ``foxglove.SceneUpdate`` in JSON or protobuf (:mod:`.foxglove`): cube entities;
 - ``tf2_msgs/TFMessage`` (``/tf``, ``/tf_static``) and ``nav_msgs/Odometry`` (a link from its
-  ``header.frame_id`` to its ``child_frame_id``).
+  ``header.frame_id`` to its ``child_frame_id``, with the twist's linear velocity).
 
 Shapes: a bounding box gives length, width, height (its dimensions x, y, z); a cylinder its
 diameter as length and width; a polygon only its height (length and width unknown, NaN).
@@ -284,6 +284,7 @@ def _tf() -> tuple[frozenset[str], Callable[[dict[str, Level]], Transforms]]:
 def _odometry() -> tuple[frozenset[str], Callable[[dict[str, Level]], Transforms]]:
     wanted = {"header.stamp.sec", "header.stamp.nanosec", "header.frame_id", "child_frame_id"}
     wanted |= {f"pose.pose.position.{a}" for a in _XYZ} | {f"pose.pose.orientation.{a}" for a in "xyzw"}
+    wanted |= {f"twist.twist.linear.{a}" for a in _XYZ}
 
     def links(levels: dict[str, Level]) -> Transforms:
         f = levels[""].fields
@@ -295,6 +296,7 @@ def _odometry() -> tuple[frozenset[str], Callable[[dict[str, Level]], Transforms
             _frames(f["child_frame_id"]),
             _vector(f, "pose.pose.position.", _XYZ, rows),
             _vector(f, "pose.pose.orientation.", "xyzw", rows),
+            _vector(f, "twist.twist.linear.", _XYZ, rows),
         )
 
     return frozenset(wanted), links

@@ -30,7 +30,8 @@ trace of one chunk.
 (:class:`TfBuffer`: linear in translation, slerp in rotation); the ego (object ``ego``) is
 ``ego_frame``'s pose in the map frame at the frame's stamp, when ``ego_frame`` reaches the map
 frame. Headings come from the yaw of the box in the map frame; velocities are the box's twist
-turned into the map frame (the ego's velocity is not read: NaN). A missing transform at the
+turned into the map frame; the ego's velocity is its odometry twist where an odometry topic
+gives its link (NaN from ``/tf``), its size unknown. A missing transform at the
 end of input is a :class:`UserError` naming the topic and the message's log time.
 """
 
@@ -327,8 +328,9 @@ class FrameBuilder:
             raise UserError(
                 f"ego frame {self.options.ego_frame!r} at stamp {int(stamps[exc.row])} ns: {exc.reason}"
             ) from None
-        unknown = np.full((len(stamps), 5), np.nan)
-        return np.column_stack([xyz, heading_from_yaw(yaw_of(quat)), unknown])
+        size = np.full((len(stamps), 3), np.nan)
+        velocity = self.tf.velocity(self.options.ego_frame, self.options.map_frame, stamps, quat)
+        return np.column_stack([xyz, heading_from_yaw(yaw_of(quat)), size, velocity[:, :2]])
 
     def _trace(self, stamps, ids, categories, frame, columns, has_ego: bool, images: ImageLayer | None) -> LabelTrace:
         if self.origin is None:

@@ -60,7 +60,8 @@ class Boxes:
 @dataclass(frozen=True)
 class Transforms:
     """Frame links: ``parent`` <- ``child`` at ``stamp`` (ns): the child's origin ``xyz`` (n, 3)
-    and orientation ``quat`` (n, 4) in the parent frame; ``static`` links hold at all times."""
+    and orientation ``quat`` (n, 4) in the parent frame, and where the message gives it (an
+    odometry twist) the child's ``velocity`` (n, 3, m/s) in the child's own frame."""
 
     message: np.ndarray
     stamp: np.ndarray
@@ -68,7 +69,7 @@ class Transforms:
     child: np.ndarray
     xyz: np.ndarray
     quat: np.ndarray
-    static: bool = False
+    velocity: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.message)

@@ -2,9 +2,10 @@
 
 Each child frame has one parent (the latest link received names it; a link naming another
 parent replaces the child's history). A link's samples are kept sorted by stamp; at a stamp
-between two samples the translation is interpolated linearly and the rotation by slerp; at a
-sample's stamp it is that sample exactly. There is no extrapolation: a stamp before a link's
-first sample or after its last is missing (:class:`MissingTransform`). Static links
+between two samples the translation (and a velocity, an odometry twist) is interpolated
+linearly and the rotation by slerp; at a sample's stamp it is that sample exactly. There is no
+extrapolation: a stamp before a link's first sample or after its last is missing
+(:class:`MissingTransform`). Static links
 (``/tf_static``) hold at every stamp. Quaternions are (x, y, z, w).
 """
 
@@ -83,30 +84,35 @@ class _Link:
     stamps: list[int] = field(default_factory=list)
     xyz: list[np.ndarray] = field(default_factory=list)
     quat: list[np.ndarray] = field(default_factory=list)
-    _arrays: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    velocity: list[np.ndarray] = field(default_factory=list)
+    _arrays: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
-    def add(self, stamps: np.ndarray, xyz: np.ndarray, quat: np.ndarray) -> None:
+    def add(self, stamps: np.ndarray, xyz: np.ndarray, quat: np.ndarray, velocity: np.ndarray | None) -> None:
         self.stamps.extend(stamps.tolist())
         self.xyz.append(xyz)
         self.quat.append(normalised(quat))
+        self.velocity.append(np.full(xyz.shape, np.nan) if velocity is None else velocity)
         self._arrays = None
 
-    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Stamps (sorted, one sample per stamp: the last received), positions, rotations."""
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Stamps (sorted, one sample per stamp: the last received), positions, rotations,
+        velocities (in the child frame; NaN unknown)."""
         if self._arrays is None:
             stamps = np.asarray(self.stamps, dtype=np.int64)
-            xyz, quat = np.concatenate(self.xyz), np.concatenate(self.quat)
+            columns = [np.concatenate(c) for c in (self.xyz, self.quat, self.velocity)]
             order = np.argsort(stamps, kind="stable")
-            stamps, xyz, quat = stamps[order], xyz[order], quat[order]
+            stamps = stamps[order]
             last = np.r_[stamps[1:] != stamps[:-1], True]
-            self._arrays = (stamps[last], xyz[last], quat[last])
-            self.stamps, self.xyz, self.quat = self._arrays[0].tolist(), [self._arrays[1]], [self._arrays[2]]
+            xyz, quat, velocity = (c[order][last] for c in columns)
+            self._arrays = (stamps[last], xyz, quat, velocity)
+            self.stamps, self.xyz, self.quat, self.velocity = stamps[last].tolist(), [xyz], [quat], [velocity]
         return self._arrays
 
-    def at(self, stamps: np.ndarray, child: str) -> tuple[np.ndarray, np.ndarray]:
-        known, xyz, quat = self.arrays()
+    def at(self, stamps: np.ndarray, child: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position, rotation and velocity of the child at each stamp (see the module docstring)."""
+        known, xyz, quat, velocity = self.arrays()
         if self.static:
-            return np.repeat(xyz[-1:], len(stamps), axis=0), np.repeat(quat[-1:], len(stamps), axis=0)
+            return tuple(np.repeat(c[-1:], len(stamps), axis=0) for c in (xyz, quat, velocity))  # type: ignore[return-value]
         outside = (stamps < known[0]) | (stamps > known[-1])
         if outside.any():
             row = int(np.argmax(outside))
@@ -118,13 +124,17 @@ class _Link:
         upper = np.clip(np.searchsorted(known, stamps, side="left"), 1, max(len(known) - 1, 1))
         lower = upper - 1
         if len(known) == 1:
-            return xyz[lower], quat[lower]
+            return xyz[lower], quat[lower], velocity[lower]
         span = (known[upper] - known[lower]).astype(np.float64)
         t = np.clip((stamps - known[lower]) / span, 0.0, 1.0)
         exact = stamps == known[upper]
         t = np.where(exact, 1.0, t)
-        position = np.where(exact[:, None], xyz[upper], xyz[lower] + t[:, None] * (xyz[upper] - xyz[lower]))
-        return position, np.where(exact[:, None], quat[upper], slerp(quat[lower], quat[upper], t))
+
+        def linear(values: np.ndarray) -> np.ndarray:
+            between = values[lower] + t[:, None] * (values[upper] - values[lower])
+            return np.where(exact[:, None], values[upper], between)
+
+        return linear(xyz), np.where(exact[:, None], quat[upper], slerp(quat[lower], quat[upper], t)), linear(velocity)
 
 
 class TfBuffer:
@@ -144,7 +154,8 @@ class TfBuffer:
             link = self.links.get(child)
             if link is None or link.parent != parent or link.static != static:
                 link = self.links[child] = _Link(parent, static)
-            link.add(links.stamp[rows], links.xyz[rows], links.quat[rows])
+            velocity = None if links.velocity is None else links.velocity[rows]
+            link.add(links.stamp[rows], links.xyz[rows], links.quat[rows], velocity)
 
     def chain(self, frame: str, target: str) -> list[str] | None:
         """The child frames whose links lead from ``frame`` up to ``target`` (empty when they are
@@ -177,7 +188,18 @@ class TfBuffer:
         xyz = np.zeros((len(stamps), 3))
         quat = np.tile([0.0, 0.0, 0.0, 1.0], (len(stamps), 1))
         for child in path:
-            link_xyz, link_quat = self.links[child].at(stamps, child)
+            link_xyz, link_quat, _ = self.links[child].at(stamps, child)
             xyz = quat_rotate(link_quat, xyz) + link_xyz
             quat = quat_multiply(link_quat, quat)
         return xyz, quat
+
+    def velocity(self, frame: str, target: str, stamps: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+        """The velocity (n, 3, m/s) of ``frame``'s origin in ``target``'s axes at each stamp: its own
+        link's velocity (an odometry twist, in ``frame``'s axes) turned by ``rotation`` (``frame``
+        in ``target``, from :meth:`lookup`); NaN where its link gives none. The links above it are
+        taken as still (an odometry frame's drift is not added)."""
+        link = self.links.get(frame)
+        if link is None or frame == target:
+            return np.full((len(stamps), 3), np.nan)
+        _, _, own = link.at(np.asarray(stamps, dtype=np.int64), frame)
+        return quat_rotate(rotation, own)

@@ -237,6 +237,7 @@ def test_cli_refuses_bad_options_and_targets(tmp_path, capsys):
         (["--scenic", tmp_path / "o", "--context", "1e400"], "--context inf"),
         (["--scenic", tmp_path / "o", "--prompt", "p"], "--prompt and --referred go with --refav"),
         (["--scenic", results], "not a directory"),
+        (["--scenic", " "], "--scenic: give the folder"),
     ]:
         code, err = run(["export", results, *bad], capsys)
         assert code == 2 and message in err and "Traceback" not in err, (bad, err)
@@ -245,6 +246,23 @@ def test_cli_refuses_bad_options_and_targets(tmp_path, capsys):
     assert "1 programs without a road map (the trace has no road map)" in err
     (program,) = (tmp_path / "o").iterdir()
     assert program.name == "walk-0.scenic" and "with name 'c'" in program.read_text()  # c: 2 m from w
+
+
+@pytest.mark.parametrize("target", ["--scenic", "--openscenario"])
+def test_failed_traces_and_interrupted_runs_are_said_not_silently_skipped(target, tmp_path, capsys):
+    from scenegrep.dataset.results import Results
+
+    trace = tmp_path / "walk.parquet"
+    write_trace_parquet(street_trace(), trace)
+    row = {"trace_id": trace_id_of(str(trace), "walk", 0), "name": "walk", "source": str(trace), "status": "match"}
+    row |= {"match": 0, "correspondence": '{"ego": "ego", "p": "w"}', "start_frame": 0, "end_frame": 2}
+    failed = {"trace_id": "gone", "name": "gone", "source": str(tmp_path / "gone"), "status": "failed", "error": "x"}
+    results = tmp_path / "r.parquet"
+    Results(results_table([row, failed]), "run", "interrupted").write_parquet(results)
+    code, err = run(["export", results, target, tmp_path / "out"], capsys)
+    assert code == 0 and "1 matches written" in err, err
+    assert "1 traces failed" in err and "none exported" in err and "an interrupted run" in err
+    assert len(list((tmp_path / "out").iterdir())) == 1
 
 
 def street_trace():

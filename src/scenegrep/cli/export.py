@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -102,17 +103,38 @@ def _refav(args: argparse.Namespace) -> int:
     return 0
 
 
-def _openscenario(args: argparse.Namespace) -> int:
+def _moments(args: argparse.Namespace, option: str, folder: str) -> Iterator[Any]:
+    """The preamble of ``--openscenario`` and ``--scenic``: the options checked, the output folder
+    checked (UserError for an empty name or a file), the results opened, what they leave unknown
+    said on stderr (failed traces, an interrupted run: no moments there), and the moments."""
     from ..dataset.moments import moments
-    from ..dataset.openscenario_export import write_openscenario
     from ..view.sources import ResultsSource
 
     if args.prompt is not None or args.referred is not None:
         raise UserError("--prompt and --referred go with --refav")
+    if not folder.strip():
+        raise UserError(f"{option}: give the folder to write to")
+    if Path(folder).exists() and not Path(folder).is_dir():
+        raise UserError(f"{option} {folder}: not a directory (one file per match is written into a directory)")
     source = ResultsSource.open(args.results, args.dataset)
-    summary = write_openscenario(
-        moments(source.results, lambda trace_id: source.load(trace_id)[0], args.context), args.openscenario
-    )
+    failed = source.results.counts()["failed"]
+    if not args.quiet and failed:
+        print(
+            f"scenegrep: {failed} traces failed in {args.results}: their matches are unknown, none exported",
+            file=sys.stderr,
+        )
+    if not args.quiet and source.results.status == "interrupted":
+        print(
+            f"scenegrep: {args.results} is an interrupted run: the traces it did not reach are not exported",
+            file=sys.stderr,
+        )
+    return moments(source.results, lambda trace_id: source.load(trace_id)[0], args.context)
+
+
+def _openscenario(args: argparse.Namespace) -> int:
+    from ..dataset.openscenario_export import write_openscenario
+
+    summary = write_openscenario(_moments(args, "--openscenario", args.openscenario), args.openscenario)
     if not args.quiet:
         print(
             f"scenegrep: {len(summary.files)} matches written as OpenSCENARIO 1.3 to {args.openscenario}",
@@ -140,15 +162,9 @@ def _openscenario(args: argparse.Namespace) -> int:
 
 
 def _scenic(args: argparse.Namespace) -> int:
-    from ..dataset.moments import moments
     from ..dataset.scenic_export import write_scenic_programs
-    from ..view.sources import ResultsSource
 
-    if args.prompt is not None or args.referred is not None:
-        raise UserError("--prompt and --referred go with --refav")
-    source = ResultsSource.open(args.results, args.dataset)
-    found = moments(source.results, lambda trace_id: source.load(trace_id)[0], args.context)
-    written = write_scenic_programs(found, args.scenic)
+    written = write_scenic_programs(_moments(args, "--scenic", args.scenic), args.scenic)
     if not args.quiet:
         for reason in sorted({w.without_map for w in written if w.without_map}):
             count = sum(w.without_map == reason for w in written)

@@ -160,11 +160,7 @@ def write_openscenario(
     """Write every moment as ``out_dir/<file_name>`` (atomically), each after it validated
     against the XSD; UserError, with nothing more written, at the first file that does not.
     ``created`` is the FileHeader date (default: now, the same for every file)."""
-    if not str(out_dir).strip():
-        raise UserError("--openscenario: give the folder to write to")
     folder = Path(out_dir)
-    if folder.exists() and not folder.is_dir():
-        raise UserError(f"--openscenario {out_dir}: not a directory")
     created = created or dt.datetime.now().replace(microsecond=0)
     summary = ExportSummary()
     for moment in moments:

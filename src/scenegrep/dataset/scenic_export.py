@@ -48,7 +48,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import UserError, at
+from ..errors import UserError
 from ..model.taxonomy import kind_of
 from .moments import Moment, ObjectPath
 
@@ -159,8 +159,6 @@ def write_scenic_programs(moments: Iterable[Moment], folder: str | Path) -> list
     from ..writers.atomic import atomic_path
 
     folder = Path(folder)
-    if folder.exists() and not folder.is_dir():
-        raise UserError("not a directory: --scenic writes one program per match into a directory", at(folder))
     written: list[WrittenProgram] = []
     owners: dict[str, str] = {}
     for moment in moments:

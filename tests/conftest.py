@@ -69,7 +69,7 @@ def real_dataset(real_data: Path, tmp_path_factory) -> Path:
 
 
 @pytest.hookimpl(trylast=True)
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Test files holding a ``slow`` test run first, each file's tests kept together (their
     module fixtures are built once): under ``pytest -n 2`` the long tests then start while the
     many short ones are still queued to fill in around them, instead of one long test at the end
@@ -77,3 +77,24 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     as tests/library's, before single tests.) The sort is stable: otherwise collection order."""
     slow_files = {item.path for item in items if item.get_closest_marker("slow")}
     items.sort(key=lambda item: item.path not in slow_files)
+    _name_xdist_groups(config, items)
+
+
+def _name_xdist_groups(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """On an xdist worker under ``--dist loadgroup``, end the node id of each test marked
+    ``xdist_group(NAME)`` with ``@NAME``, which is how the controller sends a group to one worker.
+
+    pytest-xdist 3.8 does this by setting ``item._nodeid``, which pytest 9 no longer reads (the
+    node id is ``item._id``): without this the groups are silently ignored and their tests spread
+    over both workers, each repeating the per-process work the group exists to share."""
+    if not getattr(config.option, "loadgroup", False):
+        return
+    from _pytest.nodeid import NodeId
+
+    for item in items:
+        names = {
+            str(m.args[0] if m.args else m.kwargs.get("name", "default")) for m in item.iter_markers("xdist_group")
+        }
+        suffix = "@" + "_".join(sorted(names))
+        if names and not item.nodeid.endswith(suffix):
+            item._id = NodeId.parse(item.nodeid + suffix)

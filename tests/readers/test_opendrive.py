@@ -36,25 +36,9 @@ def test_town01_facts_and_cache(maps_dir, cache):
     assert road_map.lanes[found].id == "road0_lane0"
 
 
-@pytest.mark.slow
-def test_scenic_directions_agree(maps_dir, cache):
-    """Our lane direction equals Scenic's own orientation (the oracle) in the middle of every
-    centreline segment longer than 25 cm, on every lane of Town01."""
-    from scenic.core.vectors import Vector
-    from scenic.domains.driving.roads import Network
-
-    road_map = opendrive.read_map(maps_dir / "Town01.xodr")
-    network = Network.fromFile(str(maps_dir / "Town01.xodr"), useCache=False, writeCache=False)
-    checked = 0
-    for lane in network.lanes:
-        pts = np.asarray(lane.centerline.points)[:, :2]
-        long = np.flatnonzero(np.hypot(*np.diff(pts, axis=0).T) > 0.25)
-        mids = (pts[long] + pts[long + 1]) / 2
-        ours = road_map.lane_direction_at(mids[:, 0], mids[:, 1], np.full(len(mids), road_map.lane_index[lane.uid]))
-        theirs = np.array([lane.orientation[Vector(*p)].yaw for p in mids])
-        assert np.all(np.abs(np.angle(np.exp(1j * (ours - theirs)))) < 0.02), lane.uid
-        checked += len(mids)
-    assert checked > 2000
+SCENIC_NETWORK = pytest.mark.xdist_group("town01-scenic-network")
+"""The tests reading Scenic's own Town01 network run in one test process (``--dist loadgroup``),
+which parses it once (seconds), instead of once in each process that runs one of them."""
 
 
 @pytest.fixture(scope="module")
@@ -69,6 +53,26 @@ def town01_with_scenic(maps_dir, tmp_path_factory):
     return road_map, network
 
 
+@pytest.mark.slow
+@SCENIC_NETWORK
+def test_scenic_directions_agree(town01_with_scenic):
+    """Our lane direction equals Scenic's own orientation (the oracle) in the middle of every
+    centreline segment longer than 25 cm, on every lane of Town01."""
+    from scenic.core.vectors import Vector
+
+    road_map, network = town01_with_scenic
+    checked = 0
+    for lane in network.lanes:
+        pts = np.asarray(lane.centerline.points)[:, :2]
+        long = np.flatnonzero(np.hypot(*np.diff(pts, axis=0).T) > 0.25)
+        mids = (pts[long] + pts[long + 1]) / 2
+        ours = road_map.lane_direction_at(mids[:, 0], mids[:, 1], np.full(len(mids), road_map.lane_index[lane.uid]))
+        theirs = np.array([lane.orientation[Vector(*p)].yaw for p in mids])
+        assert np.all(np.abs(np.angle(np.exp(1j * (ours - theirs)))) < 0.02), lane.uid
+        checked += len(mids)
+    assert checked > 2000
+
+
 def _scenic_yaw(region, x: float, y: float) -> float:
     from scenic.core.vectors import Vector
 
@@ -80,6 +84,7 @@ def _angle(a, b):
 
 
 @pytest.mark.slow
+@SCENIC_NETWORK
 def test_town01_sidewalks_come_with_scenic_centrelines_in_scenic_order(town01_with_scenic):
     road_map, network = town01_with_scenic
     assert [a.id for a in road_map.sidewalks] == [s.uid for s in network.sidewalks]
@@ -91,6 +96,7 @@ def test_town01_sidewalks_come_with_scenic_centrelines_in_scenic_order(town01_wi
 
 
 @pytest.mark.slow
+@SCENIC_NETWORK
 def test_sidewalk_directions_equal_scenics_at_random_points(town01_with_scenic):
     """Scenic's network.sidewalkRegion and walkableRegion orientations (a union: the first sidewalk
     containing the point) at 5000 uniform points of Scenic's sidewalk region, against ours."""
@@ -111,6 +117,7 @@ def test_sidewalk_directions_equal_scenics_at_random_points(town01_with_scenic):
 
 
 @pytest.mark.slow
+@SCENIC_NETWORK
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(element=st.integers(0, 63), along=st.floats(0, 1), across=st.floats(-3, 3))
 def test_sidewalk_direction_near_any_centreline_is_scenics(town01_with_scenic, element, along, across):

@@ -215,6 +215,21 @@ def test_a_failed_trace_makes_uncovered_bins_unknown_not_gaps(tmp_path, capsys):
     assert {r["gap"] for r in table if r["matches"]} == {False}
 
 
+def test_unknown_data_names_failed_traces_and_an_interrupted_run():
+    from scenegrep.dataset.coverage import unknown_data
+    from scenegrep.dataset.queries import results_table
+    from scenegrep.dataset.results import Results
+
+    failed = [{"trace_id": t, "name": t, "source": t, "status": "failed"} for t in ("a", "b", "b")]
+    assert unknown_data(Results(results_table(failed[:1]), "r", "interrupted")) == (
+        "1 trace failed; the run was interrupted before every trace was queried"
+    )
+    assert unknown_data(Results(results_table(failed))) == "2 traces failed"
+    assert unknown_data(Results(results_table([]))) == ""
+    coverage = coverage_of(_rows([_range(2.5, 2.5)]), [RANGE], 2, unknown="the run was interrupted")
+    assert [r["gap"] for r in coverage.table().to_pylist() if r["source"] is None] == [False, None]
+
+
 def test_summary_names_gaps_and_ambiguous_matches(capsys):
     code = main(["coverage", str(FIG3), str(FILES[0]), *TOLERANCES, "--bins", "3"])
     out = capsys.readouterr().out

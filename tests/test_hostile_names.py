@@ -8,8 +8,11 @@ import json
 import re
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from scenegrep.cli.main import main
+from scenegrep.writers.file_names import file_stem
 
 TRACE = "evil\x1b]0;pwned\x07"
 CAR = "car\x1b[2J"
@@ -112,3 +115,16 @@ def test_the_report_and_its_views_keep_their_markup(evil, tmp_path, capsys):
     assert views
     for view in views:
         _script_data(view.read_text())
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(), st.integers(1, 200))
+def test_file_stems_stay_in_their_folder(text, limit):
+    """Any name from data becomes a file name part that is non-empty, at most ``limit`` characters,
+    of safe characters only, and never hidden, ``.`` or ``..``."""
+    stem = file_stem(text, limit)
+    assert re.fullmatch(r"[A-Za-z0-9._-]+", stem)
+    assert len(stem) <= max(limit, len("trace"))
+    assert not stem.startswith(".") and stem not in (".", "..")
+    if re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*[A-Za-z0-9]", text) and len(text) <= limit:
+        assert stem == text

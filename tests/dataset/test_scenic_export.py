@@ -175,7 +175,7 @@ def test_hostile_names_and_paths_stay_literals_and_files_stay_in_the_folder(tmp_
     )
     files = [w.path for w in written]
     assert all(f.parent == folder for f in files) and len(set(files)) == 3
-    assert files[0].name.startswith("_.._") and files[2].name == "trace-0.scenic"
+    assert files[0].name.startswith("x_import_os") and files[2].name == "trace-0.scenic"
     assert sorted(p.name for p in folder.iterdir()) == sorted(f.name for f in files)
     assert (
         written[0].without_map.startswith("its OpenDRIVE map") and written[2].without_map == "the trace has no road map"

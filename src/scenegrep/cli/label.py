@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import sys
 from pathlib import Path
 from typing import Any
 
 from .bag_options import add_arguments as add_bag_arguments
 from .inputs import each_input
+from ..writers.file_names import file_stem
 from .layers import add_unknown_layers_argument, report_unknown_layers, unknown_layers_of
 
 
@@ -88,7 +88,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _unique(name: str, taken: set[str]) -> str:
     """A file-name-safe version of a trace name, distinct from those already ``taken``."""
-    base = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "trace"
+    base = file_stem(name)
     candidate, k = base, 1
     while candidate in taken:
         k += 1

@@ -49,6 +49,7 @@ from ..errors import UserError
 from ..model.geometry import yaw_from_heading
 from ..model.taxonomy import kind_of
 from ..writers.atomic import atomic_path
+from ..writers.file_names import file_stem
 from .moments import Moment, ObjectPath
 
 OSC_MINOR_VERSION = 3
@@ -148,7 +149,7 @@ def file_name(moment: Moment) -> str:
     """The file name of a moment: ``<trace id>-match<N>.xosc``, the trace id reduced to
     ``[A-Za-z0-9_.-]`` (no leading dot, at most 120 characters) and, when that changed it, a hash
     of the original appended, so different traces keep different names and none leaves DIR."""
-    stem = _SAFE.sub("_", moment.trace_id).lstrip(".")[:_MAX_STEM]
+    stem = file_stem(moment.trace_id, _MAX_STEM)
     if stem != moment.trace_id:
         stem = f"{stem}-{hashlib.sha256(moment.trace_id.encode()).hexdigest()[:10]}"
     return f"{stem}-match{moment.match}.xosc"

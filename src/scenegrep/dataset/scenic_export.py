@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import UserError
+from ..writers.file_names import file_stem
 from ..model.taxonomy import kind_of
 from .moments import Moment, ObjectPath
 
@@ -162,7 +163,7 @@ def write_scenic_programs(moments: Iterable[Moment], folder: str | Path) -> list
     written: list[WrittenProgram] = []
     owners: dict[str, str] = {}
     for moment in moments:
-        stem = _file_stem(moment.trace_name)
+        stem = file_stem(moment.trace_name)
         if owners.setdefault(stem, moment.trace_id) != moment.trace_id:
             stem = f"{stem}-{hashlib.sha256(moment.trace_id.encode()).hexdigest()[:10]}"
         path = folder / f"{stem}-{moment.match}.scenic"
@@ -196,12 +197,6 @@ def _map_reference(moment: Moment, folder: Path) -> tuple[str | None, str | None
     if not Path(source.path).is_file():
         return None, f"its OpenDRIVE map {_shown(source.path)} is not a file"
     return os.path.relpath(os.path.abspath(source.path), os.path.abspath(folder)), None
-
-
-def _file_stem(name: str) -> str:
-    """A trace name as a file name part: letters, digits, ``.``, ``_``, ``-``; no leading dot."""
-    stem = re.sub(r"[^A-Za-z0-9._-]", "_", name).lstrip(".")[:100]
-    return stem or "trace"
 
 
 def _header(moment: Moment, map_reference: str | None, without_map: str | None) -> list[str]:

@@ -32,8 +32,9 @@ match, median / p95; refuted = the frames moved 3 m or turned 0.3 rad; same run'
 4.8 / 9.0 matched, 3.6 / 7.9 refuted): curb starts 15.8 / 26 matched, 9.3 / 29 refuted (before,
 with the forward enumeration of :mod:`.walk_start` alone: 105 median / 650 max matched, about
 1.5 s refuted); region starts 28 / 107 matched, 14 / 75 refuted (before: the general solvers,
-undecided, without a witness: about 7 s matched, 6 s moved 3 m; median of 6 frames, one run). An earlier run (before a cheaper candidate search) gave medians of 18 / 11
-(curb) and 26 / 10 (region): the machine was shared, so these vary by about a fifth.
+undecided, without a witness: about 7 s matched, 6 s moved 3 m; median of 6 frames, one run).
+An earlier run (before a cheaper candidate search) gave medians of 18 / 11 (curb) and 26 / 10
+(region): the machine was shared, so these vary by about a fifth.
 """
 
 from __future__ import annotations

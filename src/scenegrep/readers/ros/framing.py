@@ -309,10 +309,17 @@ class FrameBuilder:
             if frame_id == self.options.map_frame:
                 continue
             rows = np.flatnonzero(boxes.frame_id == frame_id)
+            # one lookup per distinct stamp (the objects of a message share theirs)
+            stamps, each = np.unique(boxes.stamp[rows], return_inverse=True)
             try:
-                t, q = self.tf.lookup(frame_id, self.options.map_frame, boxes.stamp[rows])
-            except MissingTransform as exc:
-                raise _fail(seg.topic, int(seg.log_times[boxes.message[rows[exc.row]]]), exc.reason) from None
+                t, q = self.tf.lookup(frame_id, self.options.map_frame, stamps)
+            except MissingTransform:
+                try:  # again per row, for the row the error names
+                    self.tf.lookup(frame_id, self.options.map_frame, boxes.stamp[rows])
+                except MissingTransform as exc:
+                    raise _fail(seg.topic, int(seg.log_times[boxes.message[rows[exc.row]]]), exc.reason) from None
+                raise
+            t, q = t[each.ravel()], q[each.ravel()]
             xyz[rows] = quat_rotate(q, xyz[rows]) + t
             quat[rows] = quat_multiply(q, quat[rows])
         return xyz, quat
@@ -342,8 +349,7 @@ class FrameBuilder:
         values = (np.concatenate(columns) if columns else np.empty((0, 9)))[by_frame]
         category_all = (np.concatenate(categories) if categories else np.empty(0, dtype=object))[by_frame]
         # objects in the order they first appear (so chunks concatenate to the same table)
-        index: dict[str, int] = {}
-        inverse = np.fromiter((index.setdefault(i, len(index)) for i in ids_all), dtype=np.int64, count=len(ids_all))
+        inverse, index = _codes(ids_all)
         names = np.array(list(index), dtype=object)
         # codes are numbered in order of first appearance: a code is new where it passes every earlier one
         seen = np.maximum.accumulate(inverse) if len(inverse) else inverse
@@ -444,6 +450,19 @@ def _by_topic(chosen: list[tuple[_Segment, np.ndarray, np.ndarray]]) -> dict[str
     for item in chosen:
         out.setdefault(item[0].topic, []).append(item)
     return out
+
+
+def _codes(ids: np.ndarray) -> tuple[np.ndarray, dict[str, int]]:
+    """Each of ``ids`` (strings) numbered in order of first appearance, and the numbering. The
+    rows are grouped by string object first (a decoder repeats one object per distinct id, so
+    the Python work is per distinct object, not per row)."""
+    objects = np.fromiter(map(id, ids), dtype=np.int64, count=len(ids))
+    _, first, inverse = np.unique(objects, return_index=True, return_inverse=True)
+    index: dict[str, int] = {}
+    code = np.empty(len(first), dtype=np.int64)
+    for k in np.argsort(first, kind="stable").tolist():
+        code[k] = index.setdefault(ids[first[k]], len(index))
+    return code[inverse.ravel()], index
 
 
 def frames(

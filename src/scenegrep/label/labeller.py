@@ -43,13 +43,15 @@ def label_trace(
     config: LabelConfig | None = None,
     min_confidence: float | None = None,
     unknown_layers: UnknownLayers | None = None,
+    interval: float | None = None,
 ) -> Labelling:
     """Label ``trace`` (see the module docstring); ``min_confidence`` overrides the configuration's;
     ``unknown_layers`` is the user's choice for map layers the map does not publish (see
-    :mod:`.rules`: the crosswalks of the Cross rule)."""
+    :mod:`.rules`: the crosswalks of the Cross rule); ``interval`` (s) pins the observation interval
+    the windows are counted in (default: the median of the trace's, :class:`~.tracks.Tracks`)."""
     config = config or load_config()
     threshold = config.labels.min_confidence if min_confidence is None else min_confidence
-    tracks = Tracks.of(trace, config.tracks.max_gap_s)
+    tracks = Tracks.of(trace, config.tracks.max_gap_s, interval)
     evidence = gather(trace, road_map, tracks, config.tracks.smooth_s)
     kinds = trace.objects.kinds()[trace.states.object[tracks.order]]
     scores = confidences(evidence, kinds, tracks, config, unknown_layers)

@@ -34,8 +34,9 @@ class Tracks:
     interval: float
 
     @classmethod
-    def of(cls, trace: LabelTrace, max_gap_s: float) -> Tracks:
-        """The segments of ``trace``'s states."""
+    def of(cls, trace: LabelTrace, max_gap_s: float, interval: float | None = None) -> Tracks:
+        """The segments of ``trace``'s states; ``interval`` (s) replaces the median of the trace's
+        own steps (the online labeller pins it, :mod:`.online`)."""
         order = track_order(trace.states)
         obj = trace.states.object[order]
         time = trace.frame_time[trace.states.frame[order]]
@@ -46,7 +47,8 @@ class Tracks:
         sizes = np.diff(np.append(first, len(order)))
         start = np.repeat(first, sizes)
         inside = step[~breaks[1:]]
-        interval = float(np.median(inside)) if len(inside) else 0.1
+        if interval is None:
+            interval = float(np.median(inside)) if len(inside) else 0.1
         return cls(order, start, start + np.repeat(sizes, sizes), time, interval)
 
     def __len__(self) -> int:

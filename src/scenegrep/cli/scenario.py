@@ -15,6 +15,7 @@ their own road map, as ``ingest`` labels them. ``--online`` reads scenegrep JSON
 from __future__ import annotations
 
 import argparse
+import sys
 from collections.abc import Iterator
 from typing import Any
 
@@ -80,7 +81,7 @@ def _run_online(args: argparse.Namespace) -> int:
     from .. import readers
     from ..dataset.queries import scenario_rows
     from ..errors import UserError
-    from ..label import label_trace
+    from ..label.online import OnlineLabeller
     from ..scenario import ScenarioOptions, load_scenario, load_vocabulary
     from ..scenario.online import OnlineScenario
     from .live import report, until_stopped
@@ -96,15 +97,29 @@ def _run_online(args: argparse.Namespace) -> int:
     printer = RowPrinter(args)
     source = args.follow or "<stdin>"
     chunks, latency = _chunks(args)
+    labeller = OnlineLabeller(road_map, unknown_layers=choice)
     found = False
+
+    def match(chunk: Any) -> None:
+        nonlocal found
+        for result in latency.each_match(online.push(chunk) if chunk is not None else []):
+            identity = {"trace_id": result.trace.name, "name": result.trace.name, "source": source}
+            printer([{**identity, **row} for row in scenario_rows(result, args.all, args.explain)])
+            found |= result.matched
+
     with until_stopped():
         for chunk in chunks:
-            if chunk.behaviours is None:
-                chunk = label_trace(chunk, road_map, unknown_layers=choice).trace
-            for result in latency.each_match(online.push(chunk)):
-                identity = {"trace_id": result.trace.name, "name": result.trace.name, "source": source}
-                printer([{**identity, **row} for row in scenario_rows(result, args.all, args.explain)])
-                found |= result.matched
+            if chunk.behaviours is not None:
+                match(labeller.finish())
+                match(chunk)
+                continue
+            announced = labeller.delay() is not None
+            match(labeller.push(chunk))
+            if not announced and labeller.delay() is not None and not args.quiet:
+                print(f"scenegrep: {labeller.delay()}", file=sys.stderr)
+    match(labeller.finish())
+    for warning in labeller.warnings:
+        print(f"scenegrep: {warning}", file=sys.stderr)
     report_unknown_layers(choice)
     report(latency, args)
     return 0 if found else EXIT_NO_MATCH

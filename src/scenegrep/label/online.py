@@ -77,7 +77,17 @@ class OnlineLabeller:
     warnings: list[str] = field(default_factory=list)
     kept: LabelTrace | None = None
     done: int = 0
-    last_lane: dict[str, int] = field(default_factory=dict)
+    depth: int | None = None
+
+    def delay(self) -> str | None:
+        """The added latency in words, once the observation interval is known (else None)."""
+        if self.depth is None or self.interval is None:
+            return None
+        return (
+            f"online labels are final {self.depth} observations of a track later "
+            f"({self.depth * self.interval:.1f} s at {self.interval:.3f} s per observation; "
+            f"at most {self.depth * self.config.tracks.max_gap_s:.1f} s)"
+        )
 
     def push(self, chunk: LabelTrace) -> LabelTrace | None:
         """Append ``chunk`` (frames after the kept ones); the newly final frames, labelled."""
@@ -100,6 +110,8 @@ class OnlineLabeller:
         )
         tracks = labelling.tracks
         depth = reach(self.config, tracks, labelling.evidence.knows_intersections)
+        if self.interval is not None:
+            self.depth = depth
         self._check_interval(own, tracks, depth, labelling.evidence.knows_intersections)
         frame = trace.states.frame[tracks.order]
         position = np.arange(len(tracks))
@@ -115,12 +127,12 @@ class OnlineLabeller:
         waiting = np.bincount(frame[~final], minlength=trace.n_frames) > 0
         stop = int(np.argmax(waiting)) if waiting.any() else trace.n_frames
         out = labelling.trace.slice_frames(self.done, stop) if stop > self.done else None
-        self._check_lanes(trace, labelling.evidence.lane, tracks, stop)
         begin = stop
-        pending = ~final & (frame >= stop)
+        pending = frame >= stop
         if pending.any():
             back = np.maximum(position[pending] - depth, tracks.start[pending])
             begin = min(stop, int(frame[back].min()))
+        self._check_lanes(trace, labelling.evidence.lane, tracks, begin)
         self.kept = None if ended else trace.slice_frames(begin, trace.n_frames)
         self.done = stop - begin
         return out
@@ -136,23 +148,19 @@ class OnlineLabeller:
         if message not in self.warnings:
             self.warnings.append(message)
 
-    def _check_lanes(self, trace: LabelTrace, lane: np.ndarray, tracks: Tracks, stop: int) -> None:
-        """Remember each object's last map lane before ``stop``; declare an off-lane stretch that
-        starts the kept history while an older lane is forgotten."""
-        ids = np.asarray(trace.objects.id)
-        obj = trace.states.object[tracks.order]
+    def _check_lanes(self, trace: LabelTrace, lane: np.ndarray, tracks: Tracks, begin: int) -> None:
+        """Declare a segment cut at frame ``begin`` (the new history's start) right before an
+        off-lane observation while it had a lane before: the lane-id change at the end of that
+        off-lane stretch reads the forgotten lane offline (a forward fill over the segment)."""
         frame = trace.states.frame[tracks.order]
-        first = tracks.is_first() & (tracks.start == np.searchsorted(obj, obj, side="left"))
-        orphan = first & (lane < 0) & (frame > 0)
-        for name in ids[obj[orphan]].tolist():
-            if self.last_lane.get(name, -1) >= 0:
-                message = (
-                    f"online labels: object {name} is off-lane longer than the kept history; a lane "
-                    "change right after it may differ from offline labelling"
-                )
-                if message not in self.warnings:
-                    self.warnings.append(message)
-        seen = (lane >= 0) & (frame < stop)
-        if seen.any():
-            names = ids[obj[seen]]
-            self.last_lane.update(dict(zip(names.tolist(), lane[seen].tolist(), strict=True)))
+        cut = np.flatnonzero((frame[:-1] < begin) & (frame[1:] >= begin) & (tracks.start[1:] == tracks.start[:-1]))
+        filled = tracks.forward_fill(lane)
+        lost = cut[(lane[cut + 1] < 0) & (filled[cut] >= 0)]
+        ids = trace.objects.id[trace.states.object[tracks.order[lost]]]
+        for name in ids.tolist():
+            message = (
+                f"online labels: object {name} is off-lane longer than the kept history; a lane "
+                "change right after it may differ from offline labelling"
+            )
+            if message not in self.warnings:
+                self.warnings.append(message)

@@ -48,7 +48,10 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--all", action="store_true", help="every correspondence and window, not the first")
     parser.add_argument("--explain", action="store_true", help="explain matches and non-matches")
     parser.add_argument(
-        "--online", action="store_true", help="read trace documents or an MCAP stream from stdin, frame by frame"
+        "--online",
+        action="store_true",
+        help="read trace documents or an MCAP stream from stdin, frame by frame; unlabelled frames get the offline "
+        "labels, a fixed delay later (3.5 s at 10 Hz, said on stderr)",
     )
     add_live_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object per match")

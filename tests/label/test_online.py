@@ -140,3 +140,46 @@ def test_a_changed_interval_is_declared(interval):
     trace = LabelTrace.build("car", np.arange(n), times, ObjectTable.build(["c"], ["car"]), states)
     _, labeller = online(trace, [3])
     assert bool(labeller.warnings) == (interval != 0.1)
+
+
+REAL = {
+    "av2": "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede",
+    "nuscenes": "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl",
+}
+
+
+@pytest.mark.real_data
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(REAL))
+def test_real_logs_frame_by_frame(real_data, name):
+    """AV2 7fab2350 and nuScenes scene-0061 fed one frame at a time: every observation's label set is
+    the offline one, and ``stationary_vehicle.scenic --all`` over 10-frame windows of the first 60
+    frames finds exactly the offline windows and correspondences."""
+    from dataclasses import replace
+
+    from scenegrep import readers
+    from scenegrep.dataset.queries import scenario_rows
+    from scenegrep.scenario import ScenarioOptions, load_scenario, load_vocabulary
+    from scenegrep.scenario.online import OnlineScenario
+
+    trace = readers.read_trace(real_data / REAL[name])
+    trace = replace(trace.slice_frames(0, 60), behaviours=None)
+    road_map = readers.read_map(trace.map_source)
+    choice = UnknownLayers("permissive")
+    offline = label_trace(trace, road_map, unknown_layers=choice).trace
+    labeller = OnlineLabeller(road_map, unknown_layers=choice)
+    query = load_scenario("examples/queries/real/stationary_vehicle.scenic", load_vocabulary(None), None)
+    options = ScenarioOptions(find_all=True, unknown_layers=choice)
+    matcher = OnlineScenario(query, 10, road_map, options)
+    parts, found = [], []
+    for ready in [labeller.push(trace.slice_frames(f, f + 1)) for f in range(60)] + [labeller.finish()]:
+        if ready is not None:
+            parts.append(ready)
+            found += [row for result in matcher.push(ready) for row in scenario_rows(result, True, False)]
+    expected, got = by_observation(offline), by_observation(concatenate(parts))
+    assert got.keys() == expected.keys()
+    assert all(np.array_equal(got[key][0], member) for key, (member, _) in expected.items())
+    rows = scenario_rows(query.match(offline, 10, road_map, options), True, False)
+    key = ("start_frame", "end_frame", "correspondence")
+    assert len(rows) > 0
+    assert sorted(tuple(r[k] for k in key) for r in found) == sorted(tuple(r[k] for k in key) for r in rows)

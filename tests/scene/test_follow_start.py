@@ -182,11 +182,14 @@ def planted(kind: str, index: float, dx: float, dy: float, turn: float) -> tuple
 
 
 def check(kind: str, label: tuple[float, float, float]) -> None:
-    """The decision agrees with the reference where it is conclusive, was taken by the inverted
-    walk, and a match's witness, walked again, reproduces the label from X's domain."""
+    """The decision agrees with the reference where it is conclusive, the inverted walk alone
+    refutes nothing (only a heading no field value in the label's box takes), and a match's
+    witness, walked again, reproduces the label from X's domain (a region or box start the inverse
+    leaves undecided goes to the general solvers, which may keep a row they cannot refute)."""
     found, notes, witness = match(kind, label)
-    assert notes["follow-start:sat"] + notes["follow-start:unsat"] == 1, notes
-    if found:
+    assert sum(notes.values()) == 1, notes
+    assert notes["follow-start:unsat"] == 0 or not heading_possible(label), notes
+    if found and notes["follow-start:sat"]:
         distance, x, y = witness
         lo, hi = KINDS[kind][2]
         assert lo <= distance <= hi and in_domain(kind, x, y)
@@ -194,7 +197,16 @@ def check(kind: str, label: tuple[float, float, float]) -> None:
         assert max(abs(ex[0] - label[0]), abs(ey[0] - label[1])) <= TOL + 1e-9
     expected = reference(kind, label)
     if expected is not None:
-        assert found == expected
+        assert found == expected or (found and not notes["follow-start:sat"] and kind != "curb"), notes
+
+
+def heading_possible(label: tuple[float, float, float]) -> bool:
+    """Whether some value the field may take within TOL of the label's point is within TOL of its
+    heading (the only refutation the inverted walk makes alone)."""
+    x, y, heading = label
+    values = GEOMETRY.field_headings_in_box(FIELD, x - TOL, x + TOL, y - TOL, y + TOL, None)
+    turn = np.angle(np.exp(1j * (values - heading)))
+    return values is None or bool(np.any(np.abs(turn) <= TOL + 1e-9))
 
 
 OFFSETS = st.sampled_from([0.0, 0.0, 0.05, -0.3, 1.5, 3.0])
@@ -209,7 +221,8 @@ def test_random_start_answers_agree_with_a_brute_force_reference(kind, index, dx
 @pytest.mark.parametrize("kind", sorted(KINDS))
 def test_planted_walks_match_with_witnesses_and_far_labels_do_not(kind):
     """Three planted walks per kind match (the reference agrees); a label 80 m east of one, beyond
-    every walk's reach from the domain, is refuted by the inverted walk itself."""
+    every walk's reach from the domain, is refuted, not by the inverted walk alone (it leaves the
+    row to the forward enumeration or the general solvers)."""
     for index in (0.2, 0.5, 0.8):
         label = planted(kind, index, 0.0, 0.0, 0.0)
         assert reference(kind, label) is True
@@ -217,7 +230,7 @@ def test_planted_walks_match_with_witnesses_and_far_labels_do_not(kind):
     far = planted(kind, 0.5, 80.0, 0.0, 0.0)
     assert reference(kind, far) is False
     found, notes, _ = match(kind, far)
-    assert not found and notes["follow-start:unsat"] == 1
+    assert not found and notes["follow-start:unsat"] == 0
 
 
 @settings(max_examples=25, deadline=None, derandomize=True)
@@ -247,7 +260,7 @@ def test_scenic_samples_from_town01_match_with_witnesses_and_perturbations_do_no
     """Scenic 3.1.1's own scenes of examples/scenes/following_curb.scenic (a start on a curb) and
     following_region.scenic (a start in an intersection): each matches through the inverted walk
     with a witness whose walk (Scenic's rule) ends at the label; turned by 0.3 rad none matches;
-    moved 3 m across its heading no curb scene matches (refuted by the inverted walk), and a
+    moved 3 m across its heading no curb scene matches (refuted by the forward enumeration), and a
     region scene that does has a witness reaching the moved label."""
     from pathlib import Path
 
@@ -286,7 +299,7 @@ def test_scenic_samples_from_town01_match_with_witnesses_and_perturbations_do_no
     moved = query.match(moved_trace, road_map, options)
     if scene == "following_curb":
         assert not moved.matched.any()
-        assert moved.matches.notes["follow-start:unsat"] == trace.n_frames
+        assert moved.matches.notes["follow-regions:unsat"] == trace.n_frames
     witnesses_reach_labels(moved, moved_trace)
     turned = query.match(perturbed(trace, "obj1", "heading", 0.3), road_map, options)
     assert not turned.matched.any()

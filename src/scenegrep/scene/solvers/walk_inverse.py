@@ -16,16 +16,13 @@ start found there, walked again with Scenic's rule (:func:`~..follow.walk_end`) 
 against the row's whole system (:func:`.pointwise.satisfies`, requirements included), is the
 witness. All rows of a call are inverted together (:func:`start_preimages`).
 
-Refutations: no value the field may take in the end's box (a superset:
-:meth:`~..geometry.MapGeometry.field_headings_in_box`) meets the heading bounds; or the box is at
-most :data:`POINT_BOX_M` across and no preimage segment comes within the box's half-diagonal of
-the domain. The second treats the box as its centre: a walk from the domain ending elsewhere in
-the box either takes a heading sequence that also reaches E (then its start, moved by at most the
-half-diagonal, is such a segment's point) or passes within that distance of the linework, which
-is assumed not to happen (a set of labels of vanishing measure as the tolerance shrinks, like the
-piece boundaries of :mod:`..follow_pieces`). A row is undecided (the caller falls back to the
-forward enumeration of :mod:`.walk_start` for a curb, else to the general solvers) when a segment
-meets the domain but no witness passes the check, or when the box is wider.
+Refutation (the one "unsat" this module gives): no value the field may take in the end's box (a
+superset: :meth:`~..geometry.MapGeometry.field_headings_in_box`) meets the heading bounds. Every
+other row without a witness is undecided, and the caller decides it by the forward enumeration of
+:mod:`.walk_start` (a curb start) or by the general solvers (a region or box start), which refute
+soundly: the preimage is not relied on to refute, because it may miss a walk (random Town01 walks
+whose start is not in the preimage of their end: :mod:`..follow_inverse`), and a wrong refutation
+is a silently wrong "no match".
 
 Speed (Town01, ``benchmarks/bench_follow.py``: 30 Scenic scenes per start, CPU ms per one-frame
 match, median / p95; refuted = the frames moved 3 m or turned 0.3 rad; same run's known start:
@@ -55,9 +52,6 @@ from .branch_prune import Outcome
 from .pointwise import bound_violation, satisfies
 from .problem import Bound, PointUnknown, Problem
 from .walk import ROAD_DIRECTION, _follow_terms
-
-POINT_BOX_M = 1e-3
-"""The widest end box (metres, either side) whose centre stands for it in a refutation."""
 
 PARALLEL = 1e-9
 """A preimage segment and a curb segment whose directions' sine is below this run along each other."""
@@ -194,9 +188,7 @@ def solve_start_walk(
             walked = {**assignment, walk.ends[0]: float(end_x[k]), walk.ends[1]: float(end_y[k])}
             if satisfies(problem, geometry, walked):
                 return Outcome("sat", assignment, "follow-start")
-    if max(x1 - x0, y1 - y0) / 2 > POINT_BOX_M or np.any(shapely.dwithin(lines, domain, margin)):
-        return Outcome("undecided", None, "follow-start")
-    return Outcome("unsat", None, "follow-start")
+    return Outcome("undecided", None, "follow-start")
 
 
 def _heading_possible(geometry: MapGeometry, box, headings: list[Bound]) -> bool:

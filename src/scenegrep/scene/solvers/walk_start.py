@@ -106,6 +106,8 @@ def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> 
             shapely.linestrings(np.stack([curbs.start, curbs.end], axis=1)), shapely.box(x0, y0, x1, y1), reach + 1e-9
         )
     )
+    if not len(near):
+        return Outcome("unsat", None, "follow-regions")  # a walk ends at most |D| from its start
     start, end = _pieces(curbs.start[near], curbs.end[near])
     miss, hints = _sampled_miss(geometry, start, end, walk)
     order = np.argsort(miss, kind="stable")

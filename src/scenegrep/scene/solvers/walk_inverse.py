@@ -30,8 +30,10 @@ match, median / p95; refuted = the frames moved 3 m or turned 0.3 rad; same run'
 with the forward enumeration of :mod:`.walk_start` alone: 105 median / 650 max matched, about
 1.5 s refuted); region starts 28 / 107 matched, 14 / 75 refuted (before: the general solvers,
 undecided, without a witness: about 7 s matched, 6 s moved 3 m; median of 6 frames, one run).
-An earlier run (before a cheaper candidate search) gave medians of 18 / 11 (curb) and 26 / 10
-(region): the machine was shared, so these vary by about a fifth.
+Those refuted numbers are from when the preimage refuted alone; with the fallback (one run, 30
+frames, repeat 1, known 3.6 / 3.1 ms): curb 12.7 / 21 matched, 133 / 3112 refuted; region
+26 / 110 matched, 35 / 11464 refuted. An earlier run (before a cheaper candidate search) gave
+medians of 18 / 11 (curb) and 26 / 10 (region): the machine was shared, so these vary by about a fifth.
 """
 
 from __future__ import annotations

@@ -111,22 +111,32 @@ def walk_pieces(problems: list[Problem], walks: list[Walk | None], geometry: Map
         return {}
     ranges = np.array([(walks[k].lo, walks[k].hi) for k in rows], dtype=float)  # type: ignore[union-attr]
     starts = np.array([(walks[k].x, walks[k].y) for k in rows], dtype=float)  # type: ignore[union-attr]
-    target = np.array([_target(problems[k], walks[k]) for k in rows], dtype=float)  # type: ignore[arg-type]
+    target = np.array([end_box(problems[k], walks[k].ends) for k in rows], dtype=float)  # type: ignore[arg-type]
     pieces = follow_pieces(geometry, ROAD_DIRECTION, starts[:, 0], starts[:, 1], ranges[:, 0], ranges[:, 1], target)
     order = np.argsort(pieces.row, kind="stable")
     bounds = np.searchsorted(pieces.row[order], np.arange(len(rows) + 1))
     return {row: pieces.take(order[bounds[i] : bounds[i + 1]]) for i, row in enumerate(rows)}
 
 
-def _target(problem: Problem, walk: Walk) -> tuple[float, float, float, float]:
-    """The box (x_lo, x_hi, y_lo, y_hi) the walk's end must lie in by the bounds on its coordinates."""
+def end_box(problem: Problem, ends: tuple[Term, ...]) -> tuple[float, float, float, float]:
+    """The box (x_lo, x_hi, y_lo, y_hi) a walk's end (``ends``: its coordinate terms) must lie in by
+    the bounds on its coordinates; infinite sides where there are none."""
     box = [-math.inf, math.inf, -math.inf, math.inf]
     for bound in problem.bounds:
-        if bound.term in walk.ends and not bound.angle:
+        if bound.term in ends and not bound.angle:
             axis = bound.term.value[1]
             box[2 * axis] = max(box[2 * axis], bound.lo)
             box[2 * axis + 1] = min(box[2 * axis + 1], bound.hi)
     return box[0], box[1], box[2], box[3]
+
+
+def only_end_box(problem: Problem, ends: tuple[Term, ...]) -> tuple[float, float, float, float] | None:
+    """:func:`end_box` when it is finite and every bound of the row is on the end's coordinates or
+    on the road direction there; else None."""
+    if any(not (b.term in ends and not b.angle) and not is_end_heading(b.term, ends) for b in problem.bounds):
+        return None
+    box = end_box(problem, ends)
+    return box if all(math.isfinite(v) for v in box) else None
 
 
 def solve_walk(
@@ -188,7 +198,7 @@ def _form(term: Term, walk: Walk, pieces: Pieces, memo: dict) -> tuple[np.ndarra
     elif term.op == "follow":
         axis = term.value[1]
         result = (np.full(n, walk.x if axis == 0 else walk.y), pieces.ax if axis == 0 else pieces.ay)
-    elif _is_end_heading(term, walk):
+    elif is_end_heading(term, walk.ends):
         result = (pieces.heading, np.zeros(n))
     else:
         result = _form_op(term, [_form(a, walk, pieces, memo) for a in term.args])
@@ -213,9 +223,15 @@ def _form_op(term: Term, args: list[tuple[np.ndarray, np.ndarray]]) -> tuple[np.
     raise NotSimple(f"{op} of the distance")
 
 
-def _is_end_heading(term: Term, walk: Walk) -> bool:
-    """Whether the term is the road direction at the walk's end."""
-    return term.op == "field" and term.value == ROAD_DIRECTION and tuple(term.args) == walk.ends[:2]
+def no_parameters(term: Term) -> np.ndarray:
+    """The ``value`` argument of :func:`scenegrep.scene.follow.walk_end` for roadDirection, which has no
+    parameters (a walk that asks for one is a bug)."""
+    raise ValueError(f"roadDirection has no parameters, got {term!r}")
+
+
+def is_end_heading(term: Term, ends: tuple[Term, ...]) -> bool:
+    """Whether the term is the road direction at a walk's end (``ends``: its coordinate terms)."""
+    return term.op == "field" and term.value == ROAD_DIRECTION and tuple(term.args) == ends[:2]
 
 
 def _rewritten(problem: Problem, walk: Walk, pieces: Pieces, k: int) -> Problem:
@@ -236,7 +252,7 @@ def _rewritten(problem: Problem, walk: Walk, pieces: Pieces, k: int) -> Problem:
             return memo[term]
         if term in mapping:
             result = mapping[term]
-        elif _is_end_heading(term, walk):
+        elif is_end_heading(term, walk.ends):
             result = heading
         elif not term.args:
             result = term

@@ -53,7 +53,7 @@ from ..terms import Term
 from .branch_prune import Outcome
 from .pointwise import bound_violation, satisfies
 from .problem import Bound, PointUnknown, Problem
-from .walk import ROAD_DIRECTION, _follow_terms
+from .walk import ROAD_DIRECTION, _follow_terms, is_end_heading, no_parameters, only_end_box
 
 PARALLEL = 1e-9
 """A preimage segment and a curb segment whose directions' sine is below this run along each other."""
@@ -93,17 +93,11 @@ def find_start_walk(problem: Problem) -> StartWalk | None:
     if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi and max(-lo, hi) <= STEP_M * MAX_STEPS):
         return None
     ends = (found[0], found[1])
-    box = [-math.inf, math.inf, -math.inf, math.inf]
-    for bound in problem.bounds:
-        if bound.term in ends and not bound.angle:
-            axis = bound.term.value[1]
-            box[2 * axis], box[2 * axis + 1] = max(box[2 * axis], bound.lo), min(box[2 * axis + 1], bound.hi)
-        elif not _is_end_heading(bound.term, ends):
-            return None
-    if not all(math.isfinite(v) for v in box):
+    box = only_end_box(problem, ends)
+    if box is None:
         return None
     point = problem.points[0] if problem.points else None
-    return StartWalk(x, y, point, distance, ends, lo, hi, (box[0], box[1], box[2], box[3]))
+    return StartWalk(x, y, point, distance, ends, lo, hi, box)
 
 
 def _start_known(problem: Problem, x: Term, y: Term, distance: Term) -> bool:
@@ -115,10 +109,6 @@ def _start_known(problem: Problem, x: Term, y: Term, distance: Term) -> bool:
     if x is y or {x, y, distance} != set(problem.scalars) or len(problem.scalars) != 3:
         return False
     return all(math.isfinite(v) for u in (x, y) for v in problem.ranges[u])
-
-
-def _is_end_heading(term: Term, ends: tuple[Term, Term]) -> bool:
-    return term.op == "field" and term.value == ROAD_DIRECTION and tuple(term.args) == ends
 
 
 def domain_of(problem: Problem, walk: StartWalk, geometry: MapGeometry) -> shapely.Geometry | None:
@@ -172,7 +162,7 @@ def solve_start_walk(
 ) -> Outcome:
     """Decide the row from the preimage of its end box's centre (see the module docstring)."""
     x0, x1, y0, y1 = walk.box
-    headings = [b for b in problem.bounds if _is_end_heading(b.term, walk.ends)]
+    headings = [b for b in problem.bounds if is_end_heading(b.term, walk.ends)]
     if headings and not _heading_possible(geometry, walk.box, headings):
         return Outcome("unsat", None, "follow-start")
     ex, ey = (x0 + x1) / 2, (y0 + y1) / 2
@@ -183,7 +173,7 @@ def solve_start_walk(
     else:
         d, sx, sy = _inside(ex, ey, pre, lines, domain)
     if len(d):
-        end_x, end_y = walk_end(geometry, ROAD_DIRECTION, sx, sy, d, _no_terms)
+        end_x, end_y = walk_end(geometry, ROAD_DIRECTION, sx, sy, d, no_parameters)
         ends = (end_x >= x0) & (end_x <= x1) & (end_y >= y0) & (end_y <= y1)
         for k in np.flatnonzero(ends).tolist():
             assignment = {walk.distance: float(d[k]), walk.x: float(sx[k]), walk.y: float(sy[k])}
@@ -195,7 +185,7 @@ def solve_start_walk(
 
 def _heading_possible(geometry: MapGeometry, box, headings: list[Bound]) -> bool:
     """Whether some value the field may take in the end's box meets every heading bound."""
-    values = geometry.field_headings_in_box(ROAD_DIRECTION, box[0], box[1], box[2], box[3], _no_terms)
+    values = geometry.field_headings_in_box(ROAD_DIRECTION, box[0], box[1], box[2], box[3], no_parameters)
     if values is None:
         return True
     return any(all(bound_violation(float(h), b) <= 0 for b in headings) for h in values.tolist())
@@ -267,10 +257,6 @@ def _curb_tree(geometry: MapGeometry) -> shapely.STRtree:
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-
-
-def _no_terms(term):
-    raise ValueError(f"roadDirection has no parameters, got {term!r}")
 
 
 _CURB_TREES: weakref.WeakKeyDictionary[MapGeometry, shapely.STRtree] = weakref.WeakKeyDictionary()

@@ -37,7 +37,7 @@ from ..terms import Term
 from .branch_prune import Outcome
 from .pointwise import bound_violation, satisfies
 from .problem import PointUnknown, Problem
-from .walk import ROAD_DIRECTION, _follow_terms
+from .walk import ROAD_DIRECTION, _follow_terms, is_end_heading, no_parameters, only_end_box
 
 
 GRID = 4
@@ -79,20 +79,10 @@ def find_curb_walk(problem: Problem) -> CurbWalk | None:
     if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi and max(-lo, hi) <= STEP_M * MAX_STEPS):
         return None
     ends = (found[0], found[1])
-    box = [-math.inf, math.inf, -math.inf, math.inf]
-    for bound in problem.bounds:
-        if bound.term in ends and not bound.angle:
-            axis = bound.term.value[1]
-            box[2 * axis], box[2 * axis + 1] = max(box[2 * axis], bound.lo), min(box[2 * axis + 1], bound.hi)
-        elif not _is_end_heading(bound.term, ends):
-            return None
-    if not all(math.isfinite(v) for v in box):
+    box = only_end_box(problem, ends)
+    if box is None:
         return None
-    return CurbWalk(point, distance, ends, lo, hi, (box[0], box[1], box[2], box[3]))
-
-
-def _is_end_heading(term: Term, ends: tuple[Term, Term]) -> bool:
-    return term.op == "field" and term.value == ROAD_DIRECTION and tuple(term.args) == ends
+    return CurbWalk(point, distance, ends, lo, hi, box)
 
 
 def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> Outcome:
@@ -113,7 +103,7 @@ def solve_curb_walk(problem: Problem, walk: CurbWalk, geometry: MapGeometry) -> 
     order = np.argsort(miss, kind="stable")
     start, end, hints = start[order], end[order], hints[order]
     regions = start_regions(geometry, ROAD_DIRECTION, start, end, walk.lo, walk.hi, walk.box, hints)
-    headings = [b for b in problem.bounds if _is_end_heading(b.term, walk.ends)]
+    headings = [b for b in problem.bounds if is_end_heading(b.term, walk.ends)]
     candidates = 0
     for region in regions:
         if any(bound_violation(region.heading, b) > 0 for b in headings):
@@ -146,16 +136,12 @@ def _sampled_miss(
     points = (start[:, None, :] + where[None, :, None] * (end - start)[:, None, :]).reshape(-1, 2)
     distances = np.linspace(walk.lo, walk.hi, SAMPLES)
     x, y = np.repeat(points[:, 0], SAMPLES), np.repeat(points[:, 1], SAMPLES)
-    end_x, end_y = walk_end(geometry, ROAD_DIRECTION, x, y, np.tile(distances, len(points)), _no_terms)
+    end_x, end_y = walk_end(geometry, ROAD_DIRECTION, x, y, np.tile(distances, len(points)), no_parameters)
     miss = np.hypot(end_x - (x0 + x1) / 2, end_y - (y0 + y1) / 2).reshape(len(start), -1)
     best = np.argmin(miss, axis=1)
     length = np.hypot(*(end - start).T)
     hints = np.stack([where[best // SAMPLES] * length, distances[best % SAMPLES]], axis=1)
     return miss.min(axis=1), hints
-
-
-def _no_terms(term):
-    raise ValueError(f"roadDirection has no parameters, got {term!r}")
 
 
 def _checked_witness(

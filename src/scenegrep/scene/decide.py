@@ -253,15 +253,27 @@ def _pinned_box(ev: Evaluator, constraints: list[Linear], points: set):
     return box[px], box[py], rest, point.region
 
 
-def closed_form_witness(ev: Evaluator, group: Group, tolerance: Tolerance, row: int) -> dict[Term, float] | None:
-    """Values of the group's unknowns satisfying row ``row`` when a closed form applies (one unknown
-    in affine constraints, or a pinned point), checked against every constraint; else None."""
+def _closed_form_parts(ev: Evaluator, group: Group, tolerance: Tolerance) -> tuple[list[Linear], set, set] | None:
+    """The group's constraints when all are affine in its unknowns, with the scalar unknowns they
+    involve and the random points among the unknowns; None when some constraint is not affine."""
     try:
         constraints = _linear_constraints(ev, group, tolerance)
     except NotAffine:
         return None
-    scalars = {u for c in constraints for u in c.form.coefs}
-    points = {u.value[0] for u in ev.unknowns if u.op == "point"}
+    return (
+        constraints,
+        {u for c in constraints for u in c.form.coefs},
+        {u.value[0] for u in ev.unknowns if u.op == "point"},
+    )
+
+
+def closed_form_witness(ev: Evaluator, group: Group, tolerance: Tolerance, row: int) -> dict[Term, float] | None:
+    """Values of the group's unknowns satisfying row ``row`` when a closed form applies (one unknown
+    in affine constraints, or a pinned point), checked against every constraint; else None."""
+    parts = _closed_form_parts(ev, group, tolerance)
+    if parts is None:
+        return None
+    constraints, scalars, points = parts
     if not points and len(scalars) == 1:
         (u,) = scalars
         ok, low, high, angles = _unknown_interval(ev, constraints)
@@ -315,12 +327,10 @@ def closed_form_intervals(
     values); for a random point pinned by the position features, the tolerance box of its
     coordinates (an outer bound: the point's region may cut the box). None otherwise. Rows that
     are not feasible get meaningless values (the caller masks them)."""
-    try:
-        constraints = _linear_constraints(ev, group, tolerance)
-    except NotAffine:
+    parts = _closed_form_parts(ev, group, tolerance)
+    if parts is None:
         return None
-    scalars = {u for c in constraints for u in c.form.coefs}
-    points = {u.value[0] for u in ev.unknowns if u.op == "point"}
+    constraints, scalars, points = parts
     if not points and len(scalars) == 1:
         (u,) = scalars
         _, low, high, angles = _unknown_interval(ev, constraints)

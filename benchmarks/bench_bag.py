@@ -52,8 +52,10 @@ from mcap.writer import CompressionType, Writer
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "src"))
+sys.path.insert(0, str(REPO))
 
 from scenegrep.readers.mcap_follow import RawMessage, follow_mcap  # noqa: E402
+from tests.live_writer import has_open  # noqa: E402
 
 PATTERN = "[[:car:]]+"
 AV2 = "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
@@ -157,7 +159,8 @@ def online_latency(frames: list[list], pattern: list[str], rate: float, warm_up:
         arrivals: list[float] = []
         reader = threading.Thread(target=lambda: arrivals.extend(time.monotonic() for _ in process.stdout))
         reader.start()
-        wait_until_open(process.pid, path)
+        if not has_open(process.pid, path, 60):
+            raise SystemExit("the follower never opened the file")
         start.set()
         writer.join()
         process.wait(120)
@@ -178,23 +181,8 @@ def online_latency(frames: list[list], pattern: list[str], rate: float, warm_up:
     }
 
 
-def wait_until_open(pid: int, path: Path) -> None:
-    """Until process ``pid`` has ``path`` open (its query is compiled and it reads the file)."""
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:
-        try:
-            if any(Path(f"/proc/{pid}/fd/{fd}").resolve() == path.resolve() for fd in os.listdir(f"/proc/{pid}/fd")):
-                return
-        except OSError:
-            pass
-        time.sleep(0.01)
-    raise SystemExit("the follower never opened the file")
-
-
 def read_throughput(messages: int, objects: int) -> dict:
     """Messages per second read by the ros-bag reader (see the module docstring)."""
-    sys.path.insert(0, str(REPO))
-    sys.path.insert(0, str(REPO / "src"))
     from mcap_ros2._dynamic import serialize_dynamic
 
     from scenegrep.readers.ros.bag import bag_messages

@@ -25,6 +25,20 @@ from pathlib import Path
 from mcap.writer import CompressionType, Writer
 
 
+def has_open(pid: int, path: Path, seconds: float) -> bool:
+    """Whether process ``pid`` opens ``path`` (has loaded its query and reads the file) within
+    ``seconds``; polled every 10 ms."""
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        try:
+            if any(Path(f"/proc/{pid}/fd/{fd}").resolve() == path.resolve() for fd in os.listdir(f"/proc/{pid}/fd")):
+                return True
+        except OSError:
+            pass
+        time.sleep(0.01)
+    return False
+
+
 def main(out: str, plan_path: str) -> None:
     plan = json.loads(Path(plan_path).read_text())
     buffer = io.BytesIO()

@@ -12,7 +12,6 @@ from __future__ import annotations
 import base64
 import io
 import json
-import os
 import signal
 import struct
 import subprocess
@@ -33,6 +32,7 @@ from scenegrep.readers.mcap_follow import MAGIC, RawMessage, follow_mcap
 from scenegrep.writers.trace_json import trace_document, write_trace_json
 from scenegrep.writers.trace_parquet import write_map_parquet
 
+from .live_writer import has_open
 from .readers.ros_writer import TRACKED_TOPIC, write_detections2d, write_tracked
 from .scenario.worked_example import worked_map, worked_trace
 
@@ -127,7 +127,7 @@ def follow(folder: Path, name: str, messages: list[RawMessage], command: list[st
 
     reader = threading.Thread(target=read)
     reader.start()
-    wait_until_open(scenegrep.pid, target)
+    assert has_open(scenegrep.pid, target, 30), "scenegrep never opened the followed file"
     writer.stdin.write("go\n")
     writer.stdin.flush()
     written = [float(line.split()[1]) for line in writer.stdout if line.strip() != "done"]
@@ -139,19 +139,6 @@ def follow(folder: Path, name: str, messages: list[RawMessage], command: list[st
 
 def _base64(data: bytes) -> str:
     return base64.b64encode(data).decode()
-
-
-def wait_until_open(pid: int, path: Path) -> None:
-    """Until process ``pid`` has ``path`` open: it has loaded its query and reads the file."""
-    deadline = time.monotonic() + 30
-    while time.monotonic() < deadline:
-        try:
-            if any(Path(f"/proc/{pid}/fd/{fd}").resolve() == path.resolve() for fd in os.listdir(f"/proc/{pid}/fd")):
-                return
-        except OSError:
-            pass
-        time.sleep(0.01)
-    raise AssertionError("scenegrep never opened the followed file")
 
 
 def assert_in_time(run: SimpleNamespace, last_frame) -> None:

@@ -228,6 +228,20 @@ def test_info_lists_topics_and_the_options_reach_the_reader(av2, capsys):
     assert main(["info", str(path), "--rate", "nan"]) == 2
 
 
+@pytest.mark.parametrize(
+    "command",
+    [["scene", "prog.scenic"], ["scenario", "prog.scenic", "--window", "3"], ["spre", "<car>"]],
+)
+def test_bag_options_with_a_dataset_are_refused_not_ignored(command, tmp_path, capsys):
+    """A dataset's traces were read from their bags at ingest: options that change how bags are
+    read cannot apply to them, so they are an error, not silently dropped; the defaults are fine."""
+    for option in (["--rate", "2"], ["--frame-topic", TOPIC], ["--topics", TOPIC], ["--ego-frame", "none"]):
+        assert main([*command, "--dataset", str(tmp_path), *option]) == 2
+        assert "a dataset's traces were read at ingest" in capsys.readouterr().err
+    assert main([*command, "--dataset", str(tmp_path), "--map-frame", "map"]) == 2  # no program, no catalog
+    assert "read at ingest" not in capsys.readouterr().err
+
+
 def test_detected_objects_with_odometry_give_back_every_observation(short):
     """DetectedObjects carry no ids: each observation is an object ``<stamp ns>:<rank>``; the ego
     comes from a nav_msgs/Odometry topic instead of /tf."""

@@ -12,6 +12,8 @@ import contextlib
 from collections.abc import Iterator
 from typing import Any
 
+from ..errors import UserError
+
 COMMANDS_WITH_BAGS = ("info", "scene", "scenario", "spre", "label")
 """The commands whose inputs may be bags."""
 
@@ -37,7 +39,8 @@ def add_arguments(parser: Any) -> None:
 @contextlib.contextmanager
 def applied(args: argparse.Namespace) -> Iterator[None]:
     """Read bags with the command's options within the block (nothing to do for a command
-    without them)."""
+    without them). UserError when options other than the defaults go with ``--dataset``: its
+    traces were read from their bags at ingest, so the options could not apply."""
     if not hasattr(args, "ego_frame"):
         yield
         return
@@ -45,5 +48,10 @@ def applied(args: argparse.Namespace) -> Iterator[None]:
 
     topics = tuple(t.strip() for t in (args.topics or "").split(",") if t.strip())
     options = BagOptions(topics, args.frame_topic, args.rate, args.map_frame, args.ego_frame)
+    if getattr(args, "dataset", None) is not None and options != BagOptions():
+        raise UserError(
+            "--topics, --frame-topic, --rate, --map-frame and --ego-frame apply when bags are read; a dataset's "
+            "traces were read at ingest (with the defaults): query the bags as files instead"
+        )
     with using(options):
         yield

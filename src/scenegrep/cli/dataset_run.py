@@ -32,7 +32,7 @@ def add_dataset_arguments(parser: argparse.ArgumentParser, results_table: bool =
     """The options of a run over a dataset and (``results_table``) of the results table."""
     if results_table:
         group = parser.add_argument_group("results table (also over files) and datasets (scenegrep ingest)")
-        group.add_argument("--output", metavar="FILE", help="also write the results table to this Parquet file")
+        group.add_argument("-o", "--output", metavar="FILE", help="also write the results table to this Parquet file")
         group.add_argument("--csv", action="store_true", help="print the results table as CSV")
     else:
         group = parser.add_argument_group("datasets (scenegrep ingest)")

@@ -28,7 +28,9 @@ def add_parser(subparsers: Any) -> None:
         "labelled (scenegrep label's labeller) unless --no-label.",
     )
     parser.add_argument("sources", nargs="+", metavar="SOURCE", help="inputs or directories of inputs")
-    parser.add_argument("--into", required=True, metavar="DATASET", help="the dataset directory (created if needed)")
+    parser.add_argument(
+        "-o", "--into", required=True, metavar="DATASET", help="the dataset directory (created if needed)"
+    )
     parser.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes (default: all cores)")
     parser.add_argument("--no-label", action="store_true", help="do not label traces without behaviour labels")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")

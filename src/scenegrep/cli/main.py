@@ -2,7 +2,8 @@
 
 Exit codes: 0 success (for queries: some match), 1 no match, 2 user error
 (printed as one line ``scenegrep: error: PLACE: MESSAGE``), 3 some source or trace
-failed while the others were done, 130 interrupted.
+failed while the others were done, 130 interrupted. Command lines are parsed by the conventions
+of :mod:`.parsing` (options before or after positionals; unknown options with suggestions).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from collections.abc import Sequence
 from .. import __version__  # noqa: E402
 from ..errors import UserError  # noqa: E402
 from ..terminal import EscapingStream, OutputError  # noqa: E402
+from .parsing import PROGRAM, CommandParser, parse_command_line  # noqa: E402
 
 COMMANDS = (
     "coverage",
@@ -44,22 +46,15 @@ EXIT_SOME_FAILED = 3
 EXIT_INTERRUPTED = 130
 
 
-class _Parser(argparse.ArgumentParser):
-    """An argument parser whose usage errors are user errors (one line, exit 2)."""
-
-    def error(self, message: str) -> None:  # type: ignore[override]
-        raise UserError(f"{self.prog}: {message}")
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The parser of every command."""
-    parser = _Parser(
-        prog="scenegrep",
+    parser = CommandParser(
+        prog=PROGRAM,
         description="Find the moments in labeled perception data that match a "
         "scenario: Scenic scene and scenario queries, Spatial Regular Expressions.",
     )
     parser.add_argument("--version", action="version", version=f"scenegrep {__version__}")
-    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=CommandParser)
     for name in COMMANDS:
         importlib.import_module(f"{__package__}.{name}").add_parser(subparsers)
     return parser
@@ -95,7 +90,7 @@ def _discard_stdout() -> None:
 def _run(argv: Sequence[str] | None) -> int:
     try:
         parser = build_parser()
-        args = parser.parse_args(argv)
+        args = parse_command_line(parser, sys.argv[1:] if argv is None else argv)
         if args.command is None:
             parser.print_help()
             return EXIT_USER_ERROR

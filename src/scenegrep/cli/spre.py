@@ -37,7 +37,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "-c", "--channel", action="append", metavar="NAME", help="keep only this image channel (repeatable)"
     )
-    parser.add_argument("-o", "--online", action="store_true", help="online matching: a match per incoming frame")
+    parser.add_argument("--online", action="store_true", help="online matching: a match per incoming frame")
     parser.add_argument("-m", "--max-count", type=int, metavar="NUM", help="print at most NUM matches per file")
     parser.add_argument("-x", "--export", action="store_true", help="print each match's frames as one-line JSON")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")

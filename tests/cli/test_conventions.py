@@ -4,10 +4,14 @@ listing the valid ones, ``-o`` naming the output."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from scenegrep.cli.main import COMMANDS, build_parser, main
 from scenegrep.cli.parsing import parse_command_line
+
+REPO = Path(__file__).resolve().parents[2]
 
 MIXED = {
     "coverage": (["coverage", "p.scenic", "d1", "--bins", "4", "d2"], {"data": ["d1", "d2"], "bins": 4}),
@@ -153,3 +157,17 @@ def test_spre_online_has_no_short_form(parser, capsys):
 def test_double_dash_ends_options(argv, expected, parser):
     args = vars(parse_command_line(parser, argv))
     assert {key: args[key] for key in expected} == expected
+
+
+def test_scenario_window_after_the_program_runs(tmp_path, capsys):
+    """The issue's example end to end: the same results whichever side of DATA the options are."""
+    import pyarrow.parquet as pq
+
+    program = str(REPO / "examples/queries/fig1_lane_change.scenic")
+    data = str(REPO / "examples/sample/fig1_lane_change-000.parquet")
+    after, before = tmp_path / "after.parquet", tmp_path / "before.parquet"
+    assert main(["scenario", program, "--window", "3s", data, "-o", str(after), "-q"]) == 0
+    assert main(["scenario", "-q", "-o", str(before), "--window", "3s", program, data]) == 0
+    rows = pq.read_table(after).to_pylist()
+    assert rows == pq.read_table(before).to_pylist()
+    assert [row["status"] for row in rows] == ["match"]

@@ -144,9 +144,7 @@ def _over_dataset(args: argparse.Namespace, spec: Any, paths: list[str], printer
     if paths:
         raise UserError("give either DATA paths or --dataset, not both")
     quiet = args.quiet
-    run = RunOptions(
-        args.jobs, args.engine, args.address, args.resume, getattr(args, "map", None), not quiet and sys.stderr.isatty()
-    )
+    run = RunOptions(args.jobs, args.engine, args.address, args.resume, getattr(args, "map", None), not quiet)
     results = run_query(Path(args.dataset).resolve(), spec, run, on_plan=None if quiet else _report_plan)
     printer(results.table.to_pylist())
     state = " (interrupted: continue with --resume)" if results.status == "interrupted" else ""

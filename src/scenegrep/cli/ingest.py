@@ -39,12 +39,10 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
-
     from ..dataset.ingest import ingest
+    from ..progress import bar as progress_bar
 
-    show = not args.quiet and sys.stderr.isatty()
-    with tqdm(unit="source", file=sys.stderr, disable=not show, leave=False) as bar:
+    with progress_bar(quiet=args.quiet, unit="source", leave=False) as bar:
         report = ingest(
             args.sources,
             args.into,

@@ -48,12 +48,11 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
-
     from .. import readers
     from ..errors import UserError, at
     from ..label import label_trace, load_config
     from ..label.statistics import LabelStatistics
+    from ..progress import bar
     from ..writers import write_trace_parquet
 
     if args.min_confidence is not None and not 0.0 <= args.min_confidence <= 1.0:
@@ -65,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     statistics = LabelStatistics()
     choice = unknown_layers_of(args)
     names: set[str] = set()
-    with tqdm(desc="labelling", unit=" traces", disable=args.quiet, file=sys.stderr, delay=0.5) as progress:
+    with bar(desc="labelling", unit=" traces", quiet=args.quiet, delay=0.5) as progress:
 
         def label_input(path: str) -> None:
             """Label and write every trace of one input."""

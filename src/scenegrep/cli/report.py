@@ -31,18 +31,16 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
-
+    from ..progress import bar
     from ..view.report import write_report
     from ..view.sources import ResultsSource
 
     if Path(args.output).suffix.lower() != ".html":
         raise UserError(f"-o {args.output}: the report is an .html file")
     source = ResultsSource.open(args.results, args.dataset)
-    show_bar = sys.stderr.isatty() and not args.quiet
 
     def progress(views: Any) -> Any:
-        return tqdm(views, unit="view", file=sys.stderr, disable=not show_bar, leave=False)
+        return bar(views, args.quiet, unit="view", leave=False)
 
     written = write_report(source, args.output, progress)
     if not args.quiet:

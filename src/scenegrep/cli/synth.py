@@ -79,10 +79,9 @@ def _noise(args: argparse.Namespace) -> Any:
 
 
 def run(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
-
     from ..errors import UserError, at
     from ..model import MapSource
+    from ..progress import bar
     from ..synth.simulate import simulate_runs
     from ..writers import write_trace_parquet
 
@@ -106,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     stored_program = _relative(args.program, out)
     entries: list[dict[str, Any]] = []
     try:
-        for trace in tqdm(traces, total=args.runs, desc=Path(args.program).name, unit="run", disable=args.quiet):
+        for trace in bar(traces, args.quiet, total=args.runs, desc=Path(args.program).name, unit="run"):
             path = write_trace_parquet(replace(trace, map_source=stored_map), out / f"{trace.name}.parquet")
             entries.append(_entry(path.name, trace, stored_program, _relative(args.map, out)))
     finally:  # the manifest lists what was written, even when a later run fails

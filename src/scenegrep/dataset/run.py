@@ -17,7 +17,6 @@ import hashlib
 import json
 import math
 import shutil
-import sys
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -45,7 +44,8 @@ ASSUMED_KEY = b"scenegrep.assumed"
 class RunOptions:
     """How to run: ``jobs`` workers (None: all cores), ``engine`` 'local' or 'ray' (with a
     cluster ``address``; None starts a local instance), ``resume`` a previous run, a fallback
-    road map ``map_path`` for traces without one, and whether to show a ``progress`` bar."""
+    road map ``map_path`` for traces without one, and whether to show a ``progress`` bar (drawn
+    only when standard error is a terminal, :mod:`scenegrep.progress`)."""
 
     jobs: int | None = None
     engine: str = "local"
@@ -122,13 +122,12 @@ def _chunks(tasks: list[TraceTask], workers: int) -> list[list[TraceTask]]:
 
 def _execute(spec: QuerySpec, todo: list[TraceTask], parts: Path, options: RunOptions, total: int, done: int) -> str:
     """Query the traces, saving each chunk's rows as a part; 'finished' or 'interrupted'."""
-    from tqdm import tqdm
-
+    from ..progress import bar as progress_bar
     from ..writers.atomic import atomic_path
 
     chunks = _chunks(todo, options.jobs or default_jobs())
     work = [(spec, options.map_path, chunk) for chunk in chunks]
-    bar = tqdm(total=total, initial=done, unit="trace", file=sys.stderr, disable=not options.progress, leave=False)
+    bar = progress_bar(quiet=not options.progress, total=total, initial=done, unit="trace", leave=False)
     matched = 0
     try:
         for number, chunk in run_all(run_tasks, work, options.jobs, options.engine, options.address):

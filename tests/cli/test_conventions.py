@@ -4,10 +4,12 @@ listing the valid ones, ``-o`` naming the output."""
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 
 import pytest
 
+from scenegrep.cli import options
 from scenegrep.cli.main import COMMANDS, build_parser, main
 from scenegrep.cli.parsing import parse_command_line
 
@@ -171,3 +173,36 @@ def test_scenario_window_after_the_program_runs(tmp_path, capsys):
     rows = pq.read_table(after).to_pylist()
     assert rows == pq.read_table(before).to_pylist()
     assert [row["status"] for row in rows] == ["match"]
+
+
+SHARED = {
+    options.add_map_argument: ("coverage", "label", "scenario", "scene"),
+    options.add_tolerance_arguments: ("coverage", "scenario", "scene"),
+    options.add_unknown_layers_argument: ("coverage", "ingest", "label", "scenario", "scene"),
+    options.add_results_arguments: ("scenario", "scene", "spre"),
+    options.add_dataset_arguments: ("coverage", "scenario", "scene", "spre"),
+    options.add_bag_arguments: ("info", "label", "scenario", "scene", "spre"),
+    options.add_live_arguments: ("scenario", "spre"),
+}
+"""Each shared option group (:mod:`scenegrep.cli.options`) and the commands that have it."""
+
+
+def _signature(action) -> tuple:
+    return (action.dest, action.help, action.type, action.choices, action.default, action.nargs, action.required)
+
+
+@pytest.mark.parametrize("add", list(SHARED), ids=lambda add: add.__name__)
+def test_shared_options_come_from_one_place(add, parser):
+    """Every command of a group has its options exactly as the group adds them; no other command
+    has the whole group (it would belong in the table)."""
+    alone = argparse.ArgumentParser()
+    add(alone)
+    group = {name: _signature(a) for a in alone._actions[1:] for name in a.option_strings}
+    for command, sub in parser._subparsers._group_actions[0].choices.items():
+        has = {
+            name: _signature(sub._option_string_actions[name]) for name in group if name in sub._option_string_actions
+        }
+        if command in SHARED[add]:
+            assert has == group, command
+        else:
+            assert has != group, command

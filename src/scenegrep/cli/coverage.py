@@ -17,9 +17,15 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from .dataset_run import RowPrinter, add_dataset_arguments, results_of
+from .dataset_run import RowPrinter, results_of
 from .main import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
-from .scene import add_tolerance_arguments, tolerance_options
+from .options import (
+    add_dataset_arguments,
+    add_map_argument,
+    add_tolerance_arguments,
+    add_unknown_layers_argument,
+    scenic_query_options,
+)
 
 DEFAULT_BINS = 10
 
@@ -36,7 +42,9 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("program", metavar="PROGRAM", help="a .scenic file")
     parser.add_argument("data", nargs="*", metavar="DATA", help="labeled traces (files or recording directories)")
+    add_map_argument(parser)
     add_tolerance_arguments(parser)
+    add_unknown_layers_argument(parser)
     parser.add_argument(
         "--visible-distance", type=float, metavar="M", help="ignore objects and map farther than M from the ego"
     )
@@ -48,7 +56,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--html", metavar="PAGE", help="write the page of plots (.html) and the matches' views")
     parser.add_argument("--png", metavar="FILE", help="write the plots as one picture (.png)")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
-    add_dataset_arguments(parser, results_table=False)
+    add_dataset_arguments(parser)
     parser.set_defaults(run=run)
 
 
@@ -69,7 +77,11 @@ def run(args: argparse.Namespace) -> int:
     for option, path in (("--output", args.output), ("--html", args.html), ("--png", args.png)):
         if path and Path(path).is_dir():
             raise UserError(f"{option} {path}: a directory; name the file to write")
-    options: dict[str, Any] = {"visible_distance": args.visible_distance, "intervals": True, **tolerance_options(args)}
+    options: dict[str, Any] = {
+        "visible_distance": args.visible_distance,
+        "intervals": True,
+        **scenic_query_options(args),
+    }
     if args.window is not None:
         options |= {"window": args.window, "all": True}
     kind = "scene" if args.window is None else "scenario"

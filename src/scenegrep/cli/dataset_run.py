@@ -24,33 +24,8 @@ from pathlib import Path
 from typing import Any
 
 from .inputs import is_one_input
-from .layers import report_unknown_layers
 from .main import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
-
-
-def add_dataset_arguments(parser: argparse.ArgumentParser, results_table: bool = True) -> None:
-    """The options of a run over a dataset and (``results_table``) of the results table."""
-    if results_table:
-        group = parser.add_argument_group("results table (also over files) and datasets (scenegrep ingest)")
-        group.add_argument("-o", "--output", metavar="FILE", help="also write the results table to this Parquet file")
-        group.add_argument("--csv", action="store_true", help="print the results table as CSV")
-    else:
-        group = parser.add_argument_group("datasets (scenegrep ingest)")
-    group.add_argument("--dataset", metavar="DATASET", help="query every trace of an ingested dataset")
-    group.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes (default: all cores)")
-    group.add_argument("--engine", choices=["local", "ray"], default="local", help="local processes or Ray")
-    group.add_argument("--address", metavar="ADDR", help="Ray cluster address (default: start a local Ray)")
-    group.add_argument("--resume", action="store_true", help="continue an interrupted run of the same query")
-
-
-def reject_dataset_only(args: argparse.Namespace) -> None:
-    """Dataset options given without --dataset are user errors."""
-    from ..errors import UserError
-
-    if args.resume:
-        raise UserError("--resume needs --dataset")
-    if args.engine != "local" or args.jobs is not None or args.address:
-        raise UserError("--jobs, --engine and --address need --dataset")
+from .options import reject_dataset_only, report_unknown_layers, run_options_of
 
 
 def run_query_command(
@@ -138,14 +113,13 @@ class LoneFailure:
 
 
 def _over_dataset(args: argparse.Namespace, spec: Any, paths: list[str], printer: RowPrinter) -> tuple[Any, str]:
-    from ..dataset.run import RunOptions, run_query
+    from ..dataset.run import run_query
     from ..errors import UserError
 
     if paths:
         raise UserError("give either DATA paths or --dataset, not both")
-    quiet = args.quiet
-    run = RunOptions(args.jobs, args.engine, args.address, args.resume, getattr(args, "map", None), not quiet)
-    results = run_query(Path(args.dataset).resolve(), spec, run, on_plan=None if quiet else _report_plan)
+    on_plan = None if args.quiet else _report_plan
+    results = run_query(Path(args.dataset).resolve(), spec, run_options_of(args), on_plan=on_plan)
     printer(results.table.to_pylist())
     state = " (interrupted: continue with --resume)" if results.status == "interrupted" else ""
     where = (

@@ -11,8 +11,8 @@ import argparse
 import json
 from typing import Any
 
-from .bag_options import add_arguments as add_bag_arguments
 from .inputs import each_input
+from .options import add_bag_arguments
 
 
 def add_parser(subparsers: Any) -> None:

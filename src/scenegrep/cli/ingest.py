@@ -13,8 +13,8 @@ import argparse
 import sys
 from typing import Any
 
-from .layers import add_unknown_layers_argument, report_unknown_layers
 from .main import EXIT_SOME_FAILED
+from .options import add_jobs_argument, add_unknown_layers_argument, report_unknown_layers
 
 
 def add_parser(subparsers: Any) -> None:
@@ -31,7 +31,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "-o", "--into", required=True, metavar="DATASET", help="the dataset directory (created if needed)"
     )
-    parser.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes (default: all cores)")
+    add_jobs_argument(parser)
     parser.add_argument("--no-label", action="store_true", help="do not label traces without behaviour labels")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     add_unknown_layers_argument(parser)

@@ -17,10 +17,15 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .bag_options import add_arguments as add_bag_arguments
-from .inputs import each_input
 from ..writers.file_names import file_stem
-from .layers import add_unknown_layers_argument, report_unknown_layers, unknown_layers_of
+from .inputs import each_input
+from .options import (
+    add_bag_arguments,
+    add_map_argument,
+    add_unknown_layers_argument,
+    report_unknown_layers,
+    unknown_layers_of,
+)
 
 
 def add_parser(subparsers: Any) -> None:
@@ -33,9 +38,7 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("data", nargs="+", metavar="DATA", help="labeled traces (files or recording directories)")
     parser.add_argument("-o", "--output", required=True, metavar="OUT", help="directory for the labelled traces")
-    parser.add_argument(
-        "--map", metavar="MAP", help="road map for traces without one (e.g. an .xodr or a Lanelet2 .osm file)"
-    )
+    add_map_argument(parser)
     parser.add_argument("--config", metavar="FILE", help="thresholds file (layout of the shipped thresholds.toml)")
     parser.add_argument(
         "--min-confidence", type=float, metavar="C", help="keep behaviours with confidence >= C (default from config)"

@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 from array import array
 import io
-import math
 import signal
 import sys
 import time
@@ -29,34 +28,6 @@ from pathlib import Path
 from typing import Any, BinaryIO, TypeVar
 
 T = TypeVar("T")
-
-
-def add_live_arguments(parser: argparse.ArgumentParser) -> None:
-    """``--follow``, ``--idle-timeout`` and ``--latency``."""
-    parser.add_argument(
-        "--follow", metavar="FILE", help="follow an MCAP file as it is written, like tail -f (implies --online)"
-    )
-    parser.add_argument(
-        "--idle-timeout",
-        type=float,
-        metavar="S",
-        help="with --follow: stop after S seconds without new bytes (default: at the writer's end, Ctrl-C or SIGTERM)",
-    )
-    parser.add_argument(
-        "--latency", action="store_true", help="print each frame's latency on stderr at the end (median, p99)"
-    )
-
-
-def check_live_arguments(args: argparse.Namespace) -> None:
-    """UserError for ``--idle-timeout`` without ``--follow`` or not a positive number of seconds."""
-    from ..errors import UserError
-
-    if args.idle_timeout is None:
-        return
-    if args.follow is None:
-        raise UserError("--idle-timeout S needs --follow FILE")
-    if not math.isfinite(args.idle_timeout) or args.idle_timeout <= 0:
-        raise UserError(f"--idle-timeout: {args.idle_timeout} is not a positive number of seconds")
 
 
 class Latency:

@@ -94,9 +94,9 @@ def _run(argv: Sequence[str] | None) -> int:
         if args.command is None:
             parser.print_help()
             return EXIT_USER_ERROR
-        from .bag_options import applied
+        from .options import bag_options_applied
 
-        with applied(args):
+        with bag_options_applied(args):
             code = int(args.run(args))
         sys.stdout.flush()
         return code

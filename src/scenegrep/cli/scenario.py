@@ -19,12 +19,23 @@ import sys
 from collections.abc import Iterator
 from typing import Any
 
-from .bag_options import add_arguments as add_bag_arguments
-from .dataset_run import RowPrinter, add_dataset_arguments, reject_dataset_only, run_query_command
-from .layers import report_unknown_layers, unknown_layers_of
-from .live import add_live_arguments, check_live_arguments
+from .dataset_run import RowPrinter, run_query_command
 from .main import EXIT_NO_MATCH
-from .scene import add_tolerance_arguments, tolerance_of, tolerance_options
+from .options import (
+    add_bag_arguments,
+    add_dataset_arguments,
+    add_live_arguments,
+    add_map_argument,
+    add_results_arguments,
+    add_tolerance_arguments,
+    add_unknown_layers_argument,
+    check_live_arguments,
+    reject_dataset_only,
+    report_unknown_layers,
+    scenic_query_options,
+    tolerance_of,
+    unknown_layers_of,
+)
 
 
 def add_parser(subparsers: Any) -> None:
@@ -40,7 +51,9 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "--window", required=True, metavar="M", help="window length: frames (50), seconds (5s) or 'all'"
     )
+    add_map_argument(parser)
     add_tolerance_arguments(parser)
+    add_unknown_layers_argument(parser)
     parser.add_argument("--vocabulary", metavar="FILE", help="primitive behaviours -> dataset labels (TOML)")
     parser.add_argument(
         "--visible-distance", type=float, metavar="M", help="initial scene: ignore objects farther than M from the ego"
@@ -56,6 +69,7 @@ def add_parser(subparsers: Any) -> None:
     add_live_arguments(parser)
     parser.add_argument("--json", action="store_true", help="print one JSON object per match")
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
+    add_results_arguments(parser)
     add_dataset_arguments(parser)
     add_bag_arguments(parser)
     parser.set_defaults(run=run)
@@ -73,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
         "vocabulary": args.vocabulary,
         "all": args.all,
         "explain": args.explain,
-        **tolerance_options(args),
+        **scenic_query_options(args),
     }
     return run_query_command(args, "scenario", read_program(args.program), args.program, options, args.data)
 

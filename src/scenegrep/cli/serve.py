@@ -13,6 +13,7 @@ from typing import Any
 
 from ..errors import UserError
 from ..view.guard import TIME_LIMIT
+from .options import add_jobs_argument
 
 
 def add_parser(subparsers: Any) -> None:
@@ -27,7 +28,7 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("dataset", metavar="DATASET", help="an ingested dataset directory")
     parser.add_argument("--port", type=int, default=8765, help="the port (default 8765; 0 picks a free one)")
-    parser.add_argument("-j", "--jobs", type=int, metavar="N", help="worker processes per query (default: all cores)")
+    add_jobs_argument(parser, " per query")
     parser.add_argument(
         "--time-limit",
         type=float,

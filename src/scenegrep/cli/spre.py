@@ -17,10 +17,16 @@ import json
 import sys
 from typing import Any
 
-from .bag_options import add_arguments as add_bag_arguments
-from .dataset_run import add_dataset_arguments, reject_dataset_only, run_query_command
-from .live import add_live_arguments, check_live_arguments
+from .dataset_run import run_query_command
 from .main import EXIT_NO_MATCH
+from .options import (
+    add_bag_arguments,
+    add_dataset_arguments,
+    add_live_arguments,
+    add_results_arguments,
+    check_live_arguments,
+    reject_dataset_only,
+)
 
 
 def add_parser(subparsers: Any) -> None:
@@ -52,6 +58,7 @@ def add_parser(subparsers: Any) -> None:
         help="search image boxes or top-down object boxes (default: image if the input has any)",
     )
     add_live_arguments(parser)
+    add_results_arguments(parser)
     add_dataset_arguments(parser)
     add_bag_arguments(parser)
     parser.set_defaults(run=run)

@@ -8,6 +8,7 @@ they skip with a message when the folder is absent (CI always has it, and
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -15,6 +16,11 @@ from hypothesis import HealthCheck, settings
 
 settings.register_profile("scenegrep", deadline=None, suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "scenegrep"))
+
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    # A suite started in the background by a non-interactive shell (`cmd &`, nohup) ignores Ctrl-C,
+    # and its subprocesses would inherit that; the tests that stop a command with SIGINT need the default.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = Path(os.environ.get("SCENEGREP_SHARED", REPO.parent / "shared"))

@@ -137,6 +137,6 @@ def test_the_planner_keeps_a_trace_whose_ingest_labels_lack_what_the_query_reads
     assert results.counts()["matched"] == 1
     trace_id = results.matches["trace_id"][0].as_py()
     shown = ResultsSource.of_run(tmp_path, results).load(trace_id)[0].behaviours
-    queried = read_queried_trace(str(source), trace_id, unknown_layers="permissive")[0].behaviours
+    queried = read_queried_trace(str(source.resolve()), trace_id, unknown_layers="permissive")[0].behaviours
     assert shown.vocabulary == queried.vocabulary and np.array_equal(shown.member, queried.member)
     assert shown.member[:, shown.vocabulary.index("Cross")].any()

@@ -8,7 +8,9 @@ it never shows a traceback for it.
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
+from collections.abc import Sequence
 from os import PathLike
 
 
@@ -86,3 +88,13 @@ def failure_text(exc: Exception, where: str | PathLike[str]) -> str:
     if isinstance(exc, UserError):
         return exc.one_line()
     return " ".join(f"{where}: {type(exc).__name__}: {exc}".split())
+
+
+def nearest(word: str, choices: Sequence[str]) -> list[str]:
+    """The choices closest to ``word``, for a "did you mean" (at most three, best first; none if
+    nothing is close), compared without leading dashes (which every option shares); for one
+    letter (``-p``), the choices starting with it."""
+    bare = {choice.lstrip("-"): choice for choice in choices}
+    if len(word.lstrip("-")) == 1:
+        return [choice for name, choice in bare.items() if name.startswith(word.lstrip("-"))][:3]
+    return [bare[found] for found in difflib.get_close_matches(word.lstrip("-"), list(bare), n=3, cutoff=0.6)]

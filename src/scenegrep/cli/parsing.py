@@ -14,10 +14,9 @@
 from __future__ import annotations
 
 import argparse
-import difflib
 from collections.abc import Collection, Sequence
 
-from ..errors import UserError, at
+from ..errors import UserError, at, nearest
 
 PROGRAM = "scenegrep"
 
@@ -65,16 +64,6 @@ def _hide_dashed(argv: Sequence[str]) -> tuple[list[str], dict[str, str]]:
 def option_strings(parser: argparse.ArgumentParser) -> list[str]:
     """A parser's long options (``--window``), in the order they were added."""
     return [name for action in parser._actions for name in action.option_strings if name.startswith("--")]
-
-
-def nearest(word: str, choices: Sequence[str]) -> list[str]:
-    """The choices closest to ``word`` (at most three, best first; none if nothing is close),
-    compared without their leading dashes (which every option shares); for one letter (``-p``),
-    the choices starting with it."""
-    bare = {choice.lstrip("-"): choice for choice in choices}
-    if len(word.lstrip("-")) == 1:
-        return [choice for name, choice in bare.items() if name.startswith(word.lstrip("-"))][:3]
-    return [bare[found] for found in difflib.get_close_matches(word.lstrip("-"), list(bare), n=3, cutoff=0.6)]
 
 
 def did_you_mean(word: str, choices: Sequence[str]) -> str:

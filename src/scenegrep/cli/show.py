@@ -28,9 +28,14 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("target", metavar="RESULT_OR_TRACE", help="a results table (.parquet/.json/.csv) or a trace")
     parser.add_argument("-o", "--output", required=True, metavar="OUT", help="the .png, .gif or .html file to write")
     parser.add_argument(
-        "--match", type=int, default=0, metavar="N", help="which match: N-th of the table (0-based), or of --trace"
+        "--match", type=int, metavar="N", help="which match: N-th of the table (0-based, default 0), or of --trace"
     )
-    parser.add_argument("--trace", metavar="TRACE_ID", help="show this trace of the results (matched or not)")
+    parser.add_argument(
+        "--trace",
+        metavar="TRACE",
+        help="show this trace of the results (matched or not): its trace_id, name, source file, SOURCE#NAME, "
+        "or a match line's NAME:START-END (that match)",
+    )
     parser.add_argument("--frame", type=int, metavar="INDEX", help="PNG: the dataset frame index to draw")
     parser.add_argument("--dataset", metavar="DATASET", help="the dataset of the results (default: where they lie)")
     parser.add_argument("--map", metavar="MAP", help="a trace file's road map (default: the trace's own)")
@@ -40,13 +45,14 @@ def add_parser(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..view.sources import ResultsSource, is_results, trace_file_view
+    from ..view.trace_names import chosen_match
 
     suffix = Path(args.output).suffix.lower()
     if suffix not in (".png", ".gif", ".html"):
         raise UserError(f"-o {args.output}: write a .png, .gif or .html file")
     if is_results(args.target):
         source = ResultsSource.open(args.target, args.dataset)
-        trace_id, number = _chosen(source, args)
+        trace_id, number = chosen_match(source, args.trace, args.match)
         view = source.view(trace_id)
         match = view.match(number) if number is not None else None
     else:
@@ -59,17 +65,6 @@ def run(args: argparse.Namespace) -> int:
         shown = f"match {match.number} of " if match is not None else ""
         print(f"scenegrep: {shown}{view.trace.name} drawn in {args.output}", file=sys.stderr)
     return 0
-
-
-def _chosen(source: Any, args: argparse.Namespace) -> tuple[str, int | None]:
-    """The trace and its match number to show."""
-    if args.trace is None:
-        row = source.match_row(args.match)
-        return row["trace_id"], row["match"]
-    if args.trace not in source.trace_ids():
-        raise UserError(f"--trace {args.trace}: the results have no such trace")
-    matched = any(r["status"] == "match" for r in source.rows_of(args.trace))
-    return args.trace, (args.match if matched else None)
 
 
 def _write(view: Any, match: Any, args: argparse.Namespace) -> None:

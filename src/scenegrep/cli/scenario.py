@@ -100,7 +100,7 @@ def _run_online(args: argparse.Namespace) -> int:
     from ..errors import UserError
     from ..label.online import OnlineLabeller
     from ..scenario import ScenarioOptions, load_scenario, load_vocabulary
-    from ..scenario.online import OnlineScenario
+    from ..scenario.online import OnlineScenario, final_results, online_results
     from .live import report, until_stopped
 
     if args.data or args.dataset:
@@ -110,36 +110,30 @@ def _run_online(args: argparse.Namespace) -> int:
     road_map = readers.read_map(args.map) if args.map else None
     choice = unknown_layers_of(args)
     options = ScenarioOptions(tolerance_of(args), args.visible_distance, args.all, unknown_layers=choice)
-    online = OnlineScenario(query, args.window, road_map, options)
+    matcher = OnlineScenario(query, args.window, road_map, options)
+    labeller = OnlineLabeller(road_map, unknown_layers=choice)
     printer = RowPrinter(args)
     source = args.follow or "<stdin>"
     chunks, latency = _chunks(args)
-    labeller = OnlineLabeller(road_map, unknown_layers=choice)
-    found = False
 
-    def match(chunk: Any) -> None:
-        nonlocal found
-        for result in latency.each_match(online.push(chunk) if chunk is not None else []):
+    def announce(delay: str) -> None:
+        if not args.quiet:
+            print(f"scenegrep: {delay}", file=sys.stderr)
+
+    def show(results: list[Any]) -> None:
+        for result in latency.each_match(results):
             identity = {"trace_id": result.trace.name, "name": result.trace.name, "source": source}
             printer([{**identity, **row} for row in scenario_rows(result, args.all, args.explain)])
-            found |= result.matched
 
     with until_stopped():
-        for chunk in chunks:
-            if chunk.behaviours is not None:
-                match(labeller.finish())
-                match(chunk)
-                continue
-            announced = labeller.delay() is not None
-            match(labeller.push(chunk))
-            if not announced and labeller.delay() is not None and not args.quiet:
-                print(f"scenegrep: {labeller.delay()}", file=sys.stderr)
-    match(labeller.finish())
+        for results in online_results(chunks, matcher, labeller, announce):
+            show(results)
+    show(final_results(matcher, labeller))
     for warning in labeller.warnings:
         print(f"scenegrep: {warning}", file=sys.stderr)
     report_unknown_layers(choice)
     report(latency, args)
-    return 0 if found else EXIT_NO_MATCH
+    return 0 if latency.found else EXIT_NO_MATCH
 
 
 def _chunks(args: argparse.Namespace) -> tuple[Iterator[Any], Any]:

@@ -4,26 +4,17 @@ Runs a Scenic program N times in Scenic's Newtonian driving simulator (see
 :mod:`scenegrep.synth.simulate`; Scenic executes the program's Python code, so this is for
 programs the user trusts), optionally adds perception-like noise
 (:mod:`scenegrep.synth.noise`), and writes ``DIR/<program stem>-<run:03d>.parquet`` (scenegrep
-Parquet traces, each written atomically, replacing a file of the same name) and
-``DIR/manifest.json``. Each trace's map path is stored relative to DIR, so the directory and
-the map can move together. The manifest lists every trace ``synth`` wrote into DIR (entries of
-other programs written there before are kept; those of rewritten files are replaced), with
-paths relative to DIR. Exit codes: 0 written, 2 error (a bad program is reported at its
-line:column; the manifest then lists the traces written before the error).
+Parquet traces) and ``DIR/manifest.json`` (:mod:`scenegrep.synth.folder`). Exit codes: 0
+written, 2 error (a bad program is reported at its line:column; the manifest then lists the
+traces written before the error).
 """
 
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import sys
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
-
-MANIFEST = "manifest.json"
-MANIFEST_FORMAT = "scenegrep-synth-manifest"
 
 
 def add_parser(subparsers: Any) -> None:
@@ -79,19 +70,15 @@ def _noise(args: argparse.Namespace) -> Any:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..errors import UserError, at
-    from ..model import MapSource
+    from ..errors import UserError
     from ..progress import bar
+    from ..synth.folder import MANIFEST, SynthFolder
     from ..synth.simulate import simulate_runs
-    from ..writers import write_trace_parquet
 
     if min(args.runs, args.steps, args.max_iterations) < 1 or min(args.seed, args.noise_seed) < 0:
         raise UserError("--runs, --steps and --max-iterations must be at least 1, seeds non-negative")
     noise = _noise(args)
-    out = Path(args.output)
-    if out.exists() and not out.is_dir():
-        raise UserError("not a directory", at(out))
-    previous = _read_manifest(out / MANIFEST)
+    folder = SynthFolder.open(args.output)
     traces = simulate_runs(
         args.program,
         map_path=args.map,
@@ -101,65 +88,8 @@ def run(args: argparse.Namespace) -> int:
         max_iterations=args.max_iterations,
         noise=noise,
     )
-    stored_map = MapSource(os.path.relpath(args.map), "opendrive")
-    stored_program = _relative(args.program, out)
-    entries: list[dict[str, Any]] = []
-    try:
-        for trace in bar(traces, args.quiet, total=args.runs, desc=Path(args.program).name, unit="run"):
-            path = write_trace_parquet(replace(trace, map_source=stored_map), out / f"{trace.name}.parquet")
-            entries.append(_entry(path.name, trace, stored_program, _relative(args.map, out)))
-    finally:  # the manifest lists what was written, even when a later run fails
-        if entries:
-            _write_manifest(out / MANIFEST, previous, entries)
+    progress = bar(traces, args.quiet, total=args.runs, desc=Path(args.program).name, unit="run")
+    written = folder.write(progress, args.program, args.map)
     if not args.quiet:
-        print(f"scenegrep: wrote {len(entries)} traces and {MANIFEST} to {out}", file=sys.stderr)
+        print(f"scenegrep: wrote {written} traces and {MANIFEST} to {folder.path}", file=sys.stderr)
     return 0
-
-
-def _relative(path: str, out: Path) -> str:
-    """A path as seen from the output directory."""
-    return os.path.relpath(Path(path).absolute(), out.absolute())
-
-
-def _entry(file: str, trace: Any, program: str, map_path: str) -> dict[str, Any]:
-    """The manifest entry of one written trace (``program`` and ``map_path`` relative to DIR)."""
-    a = trace.attributes
-    return {
-        "file": file,
-        "program": program,
-        "map": map_path,
-        "seed": a["seed"],
-        "run": a["run"],
-        "run_seed": a["run_seed"],
-        "steps": a["steps"],
-        "frames": trace.n_frames,
-        "objects": dict(zip(trace.objects.id.tolist(), trace.objects.category.tolist())),
-        "rejected_simulations": a["rejected_simulations"],
-        "noise": a.get("noise"),
-    }
-
-
-def _read_manifest(path: Path) -> list[dict[str, Any]]:
-    """The entries of an existing manifest (none when there is no file)."""
-    from ..errors import UserError, at
-
-    if not path.exists():
-        return []
-    try:
-        doc = json.loads(path.read_text())
-        if doc.get("format") != MANIFEST_FORMAT:
-            raise ValueError
-        return list(doc["traces"])
-    except (OSError, ValueError, AttributeError, KeyError, TypeError):
-        raise UserError("not a scenegrep synth manifest; move it away or choose another -o DIR", at(path)) from None
-
-
-def _write_manifest(path: Path, previous: list[dict[str, Any]], entries: list[dict[str, Any]]) -> None:
-    """Write the manifest atomically: the previous entries of other files, then the new ones, by file name."""
-    from ..writers.atomic import atomic_path
-
-    written = {e["file"] for e in entries}
-    traces = sorted([e for e in previous if e.get("file") not in written] + entries, key=lambda e: e["file"])
-    doc = {"format": MANIFEST_FORMAT, "paths": "relative to this file's directory", "traces": traces}
-    with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(doc, indent=1) + "\n")

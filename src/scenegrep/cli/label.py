@@ -17,7 +17,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ..writers.file_names import file_stem
 from .inputs import each_input
 from .options import (
     add_bag_arguments,
@@ -52,48 +51,17 @@ def add_parser(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from .. import readers
-    from ..errors import UserError, at
-    from ..label import label_trace, load_config
-    from ..label.statistics import LabelStatistics
+    from ..label import load_config
+    from ..label.files import FolderLabelling
     from ..progress import bar
-    from ..writers import write_trace_parquet
 
-    if args.min_confidence is not None and not 0.0 <= args.min_confidence <= 1.0:
-        raise UserError("--min-confidence must be between 0 and 1")
-    config = load_config(args.config)
-    fixed_map = readers.read_map(args.map) if args.map else None
-    output = Path(args.output)
-    output.mkdir(parents=True, exist_ok=True)
-    statistics = LabelStatistics()
     choice = unknown_layers_of(args)
-    names: set[str] = set()
+    fixed_map = readers.read_map(args.map) if args.map else None
+    labelling = FolderLabelling(Path(args.output), load_config(args.config), fixed_map, args.min_confidence, choice)
     with bar(desc="labelling", unit=" traces", quiet=args.quiet, delay=0.5) as progress:
-
-        def label_input(path: str) -> None:
-            """Label and write every trace of one input."""
-            for trace in readers.read_traces(path):
-                road_map = fixed_map or (readers.read_map(trace.map_source) if trace.map_source else None)
-                try:
-                    labelled = label_trace(trace, road_map, config, args.min_confidence, choice).trace
-                except UserError as exc:  # name the input where the labeller could not
-                    raise exc if exc.location else UserError(exc.message, at(path)) from None
-                write_trace_parquet(labelled, output / f"{_unique(trace.name, names)}.parquet")
-                statistics.add(labelled)
-                progress.update()
-
-        code = each_input(args.data, label_input)
+        code = each_input(args.data, lambda path: labelling.label_input(path, progress.update))
+    statistics = labelling.statistics
     text = json.dumps(statistics.as_dict(), indent=1) if args.json else statistics.table()
     sys.stdout.write(text + "\n")
     report_unknown_layers(choice)
     return code
-
-
-def _unique(name: str, taken: set[str]) -> str:
-    """A file-name-safe version of a trace name, distinct from those already ``taken``."""
-    base = file_stem(name)
-    candidate, k = base, 1
-    while candidate in taken:
-        k += 1
-        candidate = f"{base}-{k}"
-    taken.add(candidate)
-    return candidate

@@ -206,3 +206,23 @@ def test_shared_options_come_from_one_place(add, parser):
             assert has == group, command
         else:
             assert has != group, command
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["show", "results.parquet", "-o", "x.svg"], "-o x.svg: write a .png, .gif or .html file"),
+        (["show", "results.parquet", "-o", "folder.PNG"], "-o folder.PNG: a directory; name the file to write"),
+        (["report", "results.parquet", "-o", "r.txt"], "-o r.txt: write an .html file"),
+        (["report", "results.parquet", "-o", "folder.html"], "-o folder.html: a directory; name the file to write"),
+        (["coverage", "p.scenic", "d", "-o", "t.csv"], "--output t.csv: write a .parquet or .json file"),
+        (["coverage", "p.scenic", "d", "--png", ""], "--png : write a .png file"),
+    ],
+)
+def test_output_files_are_checked_before_any_work(argv, message, tmp_path, monkeypatch, capsys):
+    """Neither the results nor the program exist: the output is refused first."""
+    monkeypatch.chdir(tmp_path)
+    for folder in ("folder.PNG", "folder.html"):
+        (tmp_path / folder).mkdir()
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"scenegrep: error: {message}\n"

@@ -24,6 +24,7 @@ from .options import (
     add_map_argument,
     add_tolerance_arguments,
     add_unknown_layers_argument,
+    check_output_file,
     scenic_query_options,
 )
 
@@ -62,21 +63,18 @@ def add_parser(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..dataset import QuerySpec
-    from ..dataset.coverage import checked_bins, check_output, coverage_of, unknown_data, variables_of
+    from ..dataset.coverage import checked_bins, coverage_of, unknown_data, variables_of
     from ..dataset.coverage_text import summary_text
-    from ..errors import UserError
     from ..scenic.parser import read_program
 
     bins = checked_bins(args.bins)
-    if args.output:
-        check_output(args.output)
-    if args.html and Path(args.html).suffix.lower() != ".html":
-        raise UserError(f"--html {args.html}: the page is an .html file")
-    if args.png and Path(args.png).suffix.lower() != ".png":
-        raise UserError(f"--png {args.png}: the picture is a .png file")
-    for option, path in (("--output", args.output), ("--html", args.html), ("--png", args.png)):
-        if path and Path(path).is_dir():
-            raise UserError(f"{option} {path}: a directory; name the file to write")
+    for option, path, suffixes in (
+        ("--output", args.output, (".parquet", ".json")),
+        ("--html", args.html, (".html",)),
+        ("--png", args.png, (".png",)),
+    ):
+        if path is not None:
+            check_output_file(option, path, suffixes)
     options: dict[str, Any] = {
         "visible_distance": args.visible_distance,
         "intervals": True,

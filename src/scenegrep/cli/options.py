@@ -16,7 +16,9 @@ Groups and who has them:
 - ROS 2 bags and MCAP files, ``--topics``, ``--frame-topic``, ``--rate``, ``--map-frame``,
   ``--ego-frame`` (info, scene, scenario, spre, label) ->
   :class:`scenegrep.readers.ros.options.BagOptions`, put in force by :func:`bag_options_applied`;
-- live input, ``--follow FILE``, ``--idle-timeout S``, ``--latency`` (scenario, spre).
+- live input, ``--follow FILE``, ``--idle-timeout S``, ``--latency`` (scenario, spre);
+- output files (``-o``, ``--html``, ``--png`` of show, report, coverage): :func:`check_output_file`
+  refuses a wrong suffix or a directory before any work.
 
 Nothing here is imported at ``--help`` time beyond argparse: the API's modules are imported by the
 functions that build their objects.
@@ -28,7 +30,8 @@ import argparse
 import contextlib
 import math
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
+from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
@@ -229,3 +232,16 @@ def check_live_arguments(args: argparse.Namespace) -> None:
         raise UserError("--idle-timeout S needs --follow FILE")
     if not math.isfinite(args.idle_timeout) or args.idle_timeout <= 0:
         raise UserError(f"--idle-timeout: {args.idle_timeout} is not a positive number of seconds")
+
+
+def check_output_file(option: str, path: str, suffixes: Sequence[str]) -> str:
+    """The suffix (lowercase, no dot) of the file ``path`` given to ``option``, checked before any
+    work: one of ``suffixes`` (``.png``; any case), and not a directory (UserError otherwise)."""
+    suffix = Path(path).suffix.lower()
+    if suffix not in suffixes:
+        listed = suffixes[0] if len(suffixes) == 1 else f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
+        article = "an" if suffixes[0][1:2] in tuple("aefhilmnorsx") else "a"
+        raise UserError(f"{option} {path}: write {article} {listed} file")
+    if Path(path).is_dir():
+        raise UserError(f"{option} {path}: a directory; name the file to write")
+    return suffix[1:]

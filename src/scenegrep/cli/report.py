@@ -9,10 +9,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 from typing import Any
 
-from ..errors import UserError
+from .options import check_output_file
 
 
 def add_parser(subparsers: Any) -> None:
@@ -35,8 +34,7 @@ def run(args: argparse.Namespace) -> int:
     from ..view.report import write_report
     from ..view.sources import ResultsSource
 
-    if Path(args.output).suffix.lower() != ".html":
-        raise UserError(f"-o {args.output}: the report is an .html file")
+    check_output_file("-o", args.output, (".html",))
     source = ResultsSource.open(args.results, args.dataset)
 
     def progress(views: Any) -> Any:

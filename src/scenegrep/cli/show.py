@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
+from .options import check_output_file
 
 
 def add_parser(subparsers: Any) -> None:
@@ -47,9 +48,7 @@ def run(args: argparse.Namespace) -> int:
     from ..view.sources import ResultsSource, is_results, trace_file_view
     from ..view.trace_names import chosen_match
 
-    suffix = Path(args.output).suffix.lower()
-    if suffix not in (".png", ".gif", ".html"):
-        raise UserError(f"-o {args.output}: write a .png, .gif or .html file")
+    check_output_file("-o", args.output, (".png", ".gif", ".html"))
     if is_results(args.target):
         source = ResultsSource.open(args.target, args.dataset)
         trace_id, number = chosen_match(source, args.trace, args.match)

@@ -4,14 +4,13 @@ balanced accuracy of a submission (:mod:`scenegrep.dataset.refav_score`).
 Both files are RefAV JSON (:mod:`scenegrep.dataset.refav_format`, what ``scenegrep export
 --refav OUT.json`` writes); a pickle is refused. ``--av2 DIR`` (the AV2 sensor split holding
 ``DIR/<log id>/map``) adds RefAV's drivable-area filter. Output: the two balanced accuracies
-(means over prompts) and each prompt's counts; ``--json`` as one JSON document. Exit codes: 0
+(means over prompts) and each prompt's counts; ``--json`` as one JSON Lines record. Exit codes: 0
 evaluated, 2 user error.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from typing import Any
@@ -34,7 +33,7 @@ def add_parser(subparsers: Any) -> None:
         "--av2", metavar="DIR", help="the AV2 sensor split of the logs (DIR/<log id>/map): drivable area"
     )
     parser.add_argument("--max-range", type=float, default=50.0, metavar="M", help="evaluation range (m; default 50)")
-    parser.add_argument("--json", action="store_true", help="print the scores as one JSON document")
+    parser.add_argument("--json", action="store_true", help="print the scores as JSON Lines (one object)")
     parser.set_defaults(run=run)
 
 
@@ -61,7 +60,9 @@ def run(args: argparse.Namespace) -> int:
         "unscored_prediction_pairs": result.unscored_pairs,
     }
     if args.json:
-        print(json.dumps(document))
+        from ..json_lines import write
+
+        write(document)
         return 0
     print(f"timestamp-level balanced accuracy: {result.timestamp_ba:.4f}")
     print(f"log-level balanced accuracy: {result.log_ba:.4f}")

@@ -8,7 +8,6 @@ others are summarised (exit code 3). One bad file given alone is a user error (e
 from __future__ import annotations
 
 import argparse
-import json
 from typing import Any
 
 from .inputs import each_input
@@ -23,7 +22,7 @@ def add_parser(subparsers: Any) -> None:
         "duration, objects per class, map elements.",
     )
     parser.add_argument("paths", nargs="+", metavar="PATH", help="file or recording directory (- for stdin)")
-    parser.add_argument("--json", action="store_true", help="print one JSON document per path")
+    parser.add_argument("--json", action="store_true", help="print JSON Lines: one object per input")
     parser.add_argument("--no-map", action="store_true", help="do not load the traces' maps")
     add_bag_arguments(parser)
     parser.set_defaults(run=run)
@@ -73,12 +72,14 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _print_summary(path: str, args: argparse.Namespace) -> None:
-    """Print the summary of one input: a JSON document with ``--json``, else text lines."""
+    """Print the summary of one input: one JSON Lines record with ``--json``, else text lines."""
     from ..summary import describe
 
     summary = describe(path, with_map=not args.no_map)
     if args.json:
-        print(json.dumps(summary))
+        from ..json_lines import write
+
+        write(summary)
         return
     print(f"{path}: {summary['description']} [{summary['format']}]")
     for topic in summary.get("topics", []):

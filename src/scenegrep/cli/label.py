@@ -2,7 +2,7 @@
 
 Writes every input trace, with derived behaviour label sets (and confidences) and the lanes
 found on the map, as ``OUT/<trace name>.parquet``; prints per-class label statistics on stdout
-(``--json`` for a JSON document). The thresholds are those of ``--config`` (default: the
+(``--json`` for one JSON Lines record). The thresholds are those of ``--config`` (default: the
 shipped, documented ``thresholds.toml``). A folder of traces is searched as the query commands
 search it; over a folder or several paths an input that cannot be read or labelled is one
 ``scenegrep: failed:`` line on stderr and the others are written (exit code 3). One bad file
@@ -12,7 +12,6 @@ given alone is a user error (exit code 2).
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 from typing import Any
@@ -42,7 +41,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "--min-confidence", type=float, metavar="C", help="keep behaviours with confidence >= C (default from config)"
     )
-    parser.add_argument("--json", action="store_true", help="print the statistics as JSON")
+    parser.add_argument("--json", action="store_true", help="print the statistics as JSON Lines (one object)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     add_unknown_layers_argument(parser)
     add_bag_arguments(parser)
@@ -61,7 +60,11 @@ def run(args: argparse.Namespace) -> int:
     with bar(desc="labelling", unit=" traces", quiet=args.quiet, delay=0.5) as progress:
         code = each_input(args.data, lambda path: labelling.label_input(path, progress.update))
     statistics = labelling.statistics
-    text = json.dumps(statistics.as_dict(), indent=1) if args.json else statistics.table()
-    sys.stdout.write(text + "\n")
+    if args.json:
+        from ..json_lines import write
+
+        write(statistics.as_dict())
+    else:
+        sys.stdout.write(statistics.table() + "\n")
     report_unknown_layers(choice)
     return code

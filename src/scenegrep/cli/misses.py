@@ -4,9 +4,9 @@ and, with ``--json``, one ``{"nearest_miss": true, ...}`` record each on stdout.
 
 from __future__ import annotations
 
-import json
 import sys
 
+from ..json_lines import write
 from ..scene.misses import NearestMisses
 
 
@@ -16,7 +16,7 @@ def print_misses(misses: NearestMisses, what: str, as_json: bool) -> None:
     for miss in misses.found:
         print(f"scenegrep: {what}: {miss.text()}", file=sys.stderr)
         if as_json:
-            sys.stdout.write(json.dumps(miss.record()) + "\n")
+            write(miss.record())
     print(f"scenegrep: {misses.summary()}", file=sys.stderr)
 
 

@@ -67,7 +67,9 @@ def add_parser(subparsers: Any) -> None:
         "labels, a fixed delay later (3.5 s at 10 Hz, said on stderr)",
     )
     add_live_arguments(parser)
-    parser.add_argument("--json", action="store_true", help="print one JSON object per match")
+    parser.add_argument(
+        "--json", action="store_true", help="print the results table as JSON Lines (one object per row)"
+    )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
     add_results_arguments(parser)
     add_dataset_arguments(parser)
@@ -113,7 +115,7 @@ def _run_online(args: argparse.Namespace) -> int:
     matcher = OnlineScenario(query, args.window, road_map, options)
     labeller = OnlineLabeller(road_map, unknown_layers=choice)
     printer = RowPrinter(args)
-    source = args.follow or "<stdin>"
+    source = args.follow or "-"
     chunks, latency = _chunks(args)
 
     def announce(delay: str) -> None:

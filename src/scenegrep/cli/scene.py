@@ -47,7 +47,9 @@ def add_parser(subparsers: Any) -> None:
         "--explain", action="store_true", help="for a trace without a match, say why each frame does not match"
     )
     parser.add_argument("--no-values", action="store_true", help="do not compute the random values of matches")
-    parser.add_argument("--json", action="store_true", help="print the results table as JSON lines")
+    parser.add_argument(
+        "--json", action="store_true", help="print the results table as JSON Lines (one object per row)"
+    )
     parser.add_argument("-q", "--quiet", action="store_true", help="print nothing; the exit code tells")
     add_results_arguments(parser)
     add_dataset_arguments(parser)

@@ -17,6 +17,7 @@ import json
 import sys
 from typing import Any
 
+from ..json_lines import line
 from .dataset_run import run_query_command
 from .main import EXIT_NO_MATCH
 from .options import (
@@ -50,7 +51,9 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument(
         "-s", "--skip", type=int, default=0, metavar="NUM", help="drop the first NUM frames of each file"
     )
-    parser.add_argument("--json", action="store_true", help="print each match as a JSON object")
+    parser.add_argument(
+        "--json", action="store_true", help="print JSON Lines: one object per results row (per match over streams)"
+    )
     parser.add_argument("--compat", choices=["strem"], help="STREM v0.2.0's syntax and precedence")
     parser.add_argument(
         "--space",
@@ -75,10 +78,12 @@ def _export(match: Any, trace: Any, options: Any) -> dict[str, Any]:
     return trace_document(trace.slice_frames(match.start, match.end))
 
 
-def _line(match: Any, prefix: str, args: argparse.Namespace, trace: Any, options: Any) -> str:
+def _line(match: Any, source: str, prefix: str, args: argparse.Namespace, trace: Any, options: Any) -> str:
+    """One match as text (``PREFIX:START-END``), a JSON Lines record (``source``: the path as
+    given, ``-`` for standard input) or, with ``--export``, the matched frames."""
     if args.json:
         record: dict[str, Any] = {
-            "source": prefix or "<stdin>",
+            "source": source,
             "start_frame": match.first_index,
             "end_frame": match.last_index,
             "start_time": match.start_time,
@@ -88,15 +93,16 @@ def _line(match: Any, prefix: str, args: argparse.Namespace, trace: Any, options
             record["trace"] = trace.name
         if match.bound:
             record["bound"] = match.bound
-        return json.dumps(record, allow_nan=True)
+        return line(record)
     if args.export and trace is not None:
         return json.dumps(_export(match, trace, options), separators=(",", ":"), allow_nan=True)
     span = "{}..{}".format(*match.index_range) if args.compat == "strem" else f"{match.first_index}-{match.last_index}"
     return f"{prefix}:{span}" if prefix else span
 
 
-def _report(matches: Any, prefix: str, args: argparse.Namespace, options: Any, trace: Any = None) -> bool:
-    """Print the matches of one file (at most --max-count); True when there was any."""
+def _report(matches: Any, source: str, prefix: str, args: argparse.Namespace, options: Any, trace: Any = None) -> bool:
+    """Print the matches of one file, ``source`` (its path as given, ``-`` for standard input),
+    each line starting with ``prefix`` (at most --max-count); True when there was any."""
     found = False
     printed = 0
     out = sys.stdout
@@ -106,7 +112,7 @@ def _report(matches: Any, prefix: str, args: argparse.Namespace, options: Any, t
             if not args.online:
                 break
             continue
-        out.write(_line(match, prefix, args, trace, options) + "\n")
+        out.write(_line(match, source, prefix, args, trace, options) + "\n")
         printed += 1
         if args.online:
             out.flush()
@@ -164,7 +170,7 @@ def _run_streams(args: argparse.Namespace) -> int:
             bound = TraceSearch(query, trace, options)
             matches = bound.online() if args.online else bound.offline()
             prefix = "" if path == "-" else f"{path}#{trace.name}" if many else path
-            found |= _report(matches, prefix, args, options, bound.trace)
+            found |= _report(matches, path, prefix, args, options, bound.trace)
     return 0 if found else EXIT_NO_MATCH
 
 
@@ -186,6 +192,7 @@ def _run_live(query: Any, args: argparse.Namespace, options: Any) -> int:
             latency = Latency(time.perf_counter, args.latency)
             chunks = latency.chunks(iter_documents(stdin))
     with until_stopped():
-        _report(latency.each_match(search_stream(query, chunks, options)), args.follow or "", args, options)
+        source = args.follow or "-"
+        _report(latency.each_match(search_stream(query, chunks, options)), source, args.follow or "", args, options)
     report(latency, args)
     return 0 if latency.found else EXIT_NO_MATCH

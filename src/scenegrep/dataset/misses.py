@@ -33,13 +33,13 @@ def nearest_misses(
     """The nearest misses over the traces of a run's 'no match' rows (the first ``limits.traces``
     of them, in order; a trace that no longer loads is counted as not examined)."""
     limits = limits or MissLimits()
-    names = {row["trace_id"]: row["name"] for row in rows if row["status"] == "no match"}
-    misses = NearestMisses(limits, skipped=max(len(names) - limits.traces, 0))
-    for trace_id in list(names)[: limits.traces]:
+    sources = {row["trace_id"]: row["source"] for row in rows if row["status"] == "no match"}
+    misses = NearestMisses(limits, skipped=max(len(sources) - limits.traces, 0))
+    for trace_id in list(sources)[: limits.traces]:
         try:
             trace, road_map = load(trace_id)
         except UserError:
             misses.skipped += 1
             continue
-        misses.add(*scene_result(spec, trace, road_map), names[trace_id])
+        misses.add(*scene_result(spec, trace, road_map), sources[trace_id])
     return misses

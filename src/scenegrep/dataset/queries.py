@@ -214,12 +214,14 @@ def involvement(correspondence: dict[str, Any], span: dict[str, Any]) -> dict[st
 
 def _span(trace: LabelTrace, first: int, last: int) -> dict[str, Any]:
     """The frame-range columns of frames at positions first..last (inclusive): their dataset
-    frame indices and their times (s)."""
+    frame indices and their times (s, to 1 ns as in JSON Lines: :mod:`scenegrep.json_lines`)."""
+    from ..json_lines import TIME_DECIMALS
+
     return {
         "start_frame": int(trace.frame_index[first]),
         "end_frame": int(trace.frame_index[last]),
-        "start_time": float(trace.frame_time[first]),
-        "end_time": float(trace.frame_time[last]),
+        "start_time": round(float(trace.frame_time[first]), TIME_DECIMALS) + 0.0,
+        "end_time": round(float(trace.frame_time[last]), TIME_DECIMALS) + 0.0,
     }
 
 

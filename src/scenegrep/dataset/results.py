@@ -139,20 +139,33 @@ JSON_COLUMNS = ("correspondence", "values", "objects", "intervals")
 
 
 def json_line(row: dict[str, Any]) -> str:
-    """A results row as one JSON object, its JSON columns decoded (``Results.read`` reads it back)."""
+    """A results row as one JSON Lines record (:mod:`scenegrep.json_lines`: numbers rounded), its
+    JSON columns decoded (``Results.read`` reads it back)."""
+    from ..json_lines import line
+
     decoded = {k: (json.loads(v) if v else None) if k in JSON_COLUMNS else v for k, v in row.items()}
-    return json.dumps(decoded, allow_nan=True)
+    return line(decoded)
 
 
 def csv_writer(stream: TextIO) -> Callable[[dict[str, Any]], None]:
-    """Writes the header row of the results' columns, and returns a function that writes a row."""
+    """Writes the header row of the results' columns, and returns a function that writes a row
+    (numbers rounded as in JSON Lines)."""
     writer = csv.writer(stream, lineterminator="\n")
     writer.writerow(RESULTS_SCHEMA.names)
 
     def write(row: dict[str, Any]) -> None:
-        writer.writerow(["" if row.get(name) is None else row[name] for name in RESULTS_SCHEMA.names])
+        writer.writerow(["" if row.get(name) is None else _cell(name, row[name]) for name in RESULTS_SCHEMA.names])
 
     return write
+
+
+def _cell(name: str, value: Any) -> Any:
+    """A CSV cell: numbers, and those in JSON columns, rounded as in JSON Lines (:mod:`scenegrep.json_lines`)."""
+    from ..json_lines import line, rounded
+
+    if name in JSON_COLUMNS and value:
+        return line(json.loads(value))
+    return rounded(value, name)
 
 
 def _json_rows(path: str | Path) -> list[dict[str, Any]]:

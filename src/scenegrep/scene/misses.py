@@ -76,7 +76,8 @@ class Shortfall:
 @dataclass(frozen=True)
 class NearestMiss:
     """A frame (position in the trace and frame index) that the raised tolerances admit with
-    ``correspondence``; ``distance`` is the ray parameter that ranks misses (smaller is nearer)."""
+    ``correspondence``; ``distance`` is the ray parameter that ranks misses (smaller is nearer).
+    ``source`` is where the trace was read (a path; its name when not given), ``trace`` its name."""
 
     source: str
     trace: str
@@ -106,7 +107,7 @@ class NearestMiss:
     def text(self) -> str:
         """One line: where, with which correspondence, what is off and the options that admit it."""
         pairs = ", ".join(f"{name}={label}" for name, label in self.correspondence.items())
-        return f"{self.source} frame {self.frame} ({pairs}): {self.shortfalls()}"
+        return f"{self.trace} frame {self.frame} ({pairs}): {self.shortfalls()}"
 
     def shortfalls(self) -> str:
         """What is off, and the options that would admit it."""
@@ -169,8 +170,8 @@ def nearest_miss(
     result: SceneResult, frames: np.ndarray, ray_cap: float = RAY_CAP, source: str | None = None
 ) -> NearestMiss | None:
     """The nearest miss among ``frames`` (positions) of a result, or None when raising every tolerance
-    up to its cap (or the ray up to ``ray_cap``) admits none of them; ``source`` names the trace in
-    its text (default: the trace's name)."""
+    up to its cap (or the ray up to ``ray_cap``) admits none of them; ``source`` is where the
+    trace was read, a path (default: the trace's name)."""
     probe = Probe(result)
     base = result.options.tolerance
     ray = _ray(probe, base, frames, ray_cap)
@@ -264,7 +265,7 @@ class NearestMisses:
         self, result: SceneResult, frames: np.ndarray | None = None, source: str | None = None
     ) -> NearestMiss | None:
         """Examine a result's frames (positions; default all), at most ``limits.frames`` of them;
-        ``source`` names the trace in the miss's text (default: its name)."""
+        ``source`` is where the trace was read, a path (default: its name)."""
         if self.traces >= self.limits.traces:
             self.skipped += 1
             return None

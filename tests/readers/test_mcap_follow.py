@@ -18,7 +18,7 @@ from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
 from scenegrep.errors import UserError
-from scenegrep.readers.mcap_follow import MAGIC, FollowOptions, RawMessage, follow_mcap
+from scenegrep.readers.mcap_follow import MAGIC, FollowOptions, RawMessage, follow_mcap, sniff_mcap
 
 QUICK = FollowOptions(poll=0.001, idle_timeout=0.3)
 
@@ -260,3 +260,26 @@ def test_batches_group_what_had_arrived_together(monkeypatch):
     monkeypatch.setattr(sys, "stdin", SimpleNamespace(buffer=_Pieces(data, [])))
     batches = list(follow_mcap("-", QUICK).batches(limit=4))
     assert [len(batch) for batch in batches] == [4, 4, 2] and sum(batches, []) == reference(data)
+
+
+class _Trickle(io.RawIOBase):
+    """A stream that hands out at most ``step`` bytes per read, as a pipe from a live writer may."""
+
+    def __init__(self, data: bytes, step: int):
+        self.data, self.step = data, step
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer) -> int:
+        size = min(len(buffer), self.step, len(self.data))
+        buffer[:size], self.data = self.data[:size], self.data[size:]
+        return size
+
+
+@settings(max_examples=60)
+@given(st.one_of(st.binary(max_size=20), st.binary(max_size=12).map(lambda b: MAGIC + b)), st.integers(1, 9))
+def test_sniffing_mcap_consumes_nothing(data, step):
+    is_mcap, stream = sniff_mcap(_Trickle(data, step))
+    assert is_mcap == data.startswith(MAGIC)
+    assert stream.read() == data

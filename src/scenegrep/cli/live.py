@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 from array import array
-import io
 import signal
 import sys
 import time
@@ -73,37 +72,11 @@ def _stats(times: array, one: str, many: str) -> str:
     return f"{count}, median {median:.2f} ms, p99 {p99:.2f} ms"
 
 
-class _Replay(io.RawIOBase):
-    """A stream whose first bytes were already read: ``head`` then the rest of ``stream``."""
-
-    def __init__(self, head: bytes, stream: BinaryIO):
-        self.head = head
-        self.stream = stream
-
-    def readable(self) -> bool:
-        return True
-
-    def readinto(self, buffer: Any) -> int:
-        if self.head:
-            size = min(len(buffer), len(self.head))
-            buffer[:size], self.head = self.head[:size], self.head[size:]
-            return size
-        read = getattr(self.stream, "read1", self.stream.read)
-        data = read(len(buffer))
-        buffer[: len(data)] = data
-        return len(data)
-
-
 def standard_input() -> tuple[bool, BinaryIO]:
     """Whether standard input is an MCAP stream, and standard input with nothing consumed."""
-    from ..readers.mcap_follow import MAGIC
+    from ..readers.mcap_follow import sniff_mcap
 
-    stream = sys.stdin.buffer
-    read = getattr(stream, "read1", stream.read)
-    head = b""
-    while len(head) < len(MAGIC) and (part := read(len(MAGIC) - len(head))):
-        head += part
-    return head == MAGIC, io.BufferedReader(_Replay(head, stream))
+    return sniff_mcap(sys.stdin.buffer)
 
 
 def mcap_chunks(path: str, args: argparse.Namespace, stdin: BinaryIO | None = None) -> tuple[Iterator[Any], Latency]:

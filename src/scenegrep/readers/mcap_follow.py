@@ -37,7 +37,7 @@ import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO, NamedTuple
+from typing import Any, BinaryIO, NamedTuple
 
 from ..errors import UserError, at
 
@@ -309,6 +309,38 @@ def _decompressor(compression: str, stream: BinaryIO) -> BinaryIO:
     import zstandard
 
     return zstandard.ZstdDecompressor().stream_reader(stream)
+
+
+class _Replay(io.RawIOBase):
+    """A stream whose first bytes were already read: ``head`` then the rest of ``stream``."""
+
+    def __init__(self, head: bytes, stream: BinaryIO):
+        self.head = head
+        self.stream = stream
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: Any) -> int:
+        if self.head:
+            size = min(len(buffer), len(self.head))
+            buffer[:size], self.head = self.head[:size], self.head[size:]
+            return size
+        read = getattr(self.stream, "read1", self.stream.read)
+        data = read(len(buffer))
+        buffer[: len(data)] = data
+        return len(data)
+
+
+def sniff_mcap(stream: BinaryIO) -> tuple[bool, BinaryIO]:
+    """Whether ``stream`` (standard input, say) starts with MCAP's magic bytes, and the stream
+    with nothing consumed (the bytes read to tell are replayed). Reads at most the magic's 8 bytes,
+    each read returning what has arrived, so a live writer is not waited for beyond them."""
+    read = getattr(stream, "read1", stream.read)
+    head = b""
+    while len(head) < len(MAGIC) and (part := read(len(MAGIC) - len(head))):
+        head += part
+    return head == MAGIC, io.BufferedReader(_Replay(head, stream))
 
 
 def follow_mcap(

@@ -74,9 +74,9 @@ def test_image_streams_are_drawn_in_the_image_and_mark_boxes():
     trace = image_trace([[[car, ped], [ped]], [[car]]], channels=("front", "back"))
     view = build_view(trace, query=QueryInfo("spre", "[[:ped:]]"))
     doc = payload(view)
-    assert view.image_space and doc["space"] == "image" and doc["boxes"]["channel"] == "front"
-    assert doc["boxes"]["offsets"] == [0, 2, 3]
-    assert doc["boxes"]["marked"] == [0, 1, 0]
+    assert view.image_space and doc["space"] == "image" and [b["channel"] for b in doc["boxes"]] == ["front", "back"]
+    assert doc["boxes"][0]["offsets"] == [0, 2, 3] and doc["boxes"][1]["offsets"] == [0, 1, 1]
+    assert doc["boxes"][0]["marked"] == [0, 1, 0] and doc["boxes"][1]["marked"] == [1]
 
 
 def test_the_map_is_cropped_to_the_trace(maps_dir):

@@ -107,6 +107,21 @@ def build_view(
     )
 
 
+def image_channels(view: TraceView) -> tuple[str, ...]:
+    """The camera channels an image view draws, the one to show first first: the channels the
+    SpRE ran on (``--channel``, in its order), then the others by decreasing number of boxes
+    (ties in the trace's order). Channels without a sample are left out."""
+    assert view.trace.images is not None
+    samples, boxes = view.trace.images.samples, view.trace.images.boxes
+    n = len(samples.channels)
+    present = np.bincount(samples.channel, minlength=n) > 0
+    counts = np.bincount(samples.channel[boxes.sample], minlength=n)
+    asked = [] if view.query is None else list(view.query.options.get("channels") or [])
+    first = [samples.channels.index(c) for c in dict.fromkeys(asked) if c in samples.channels]
+    rest = [int(k) for k in np.argsort(-counts, kind="stable") if present[k] and int(k) not in first]
+    return tuple(samples.channels[k] for k in first + rest if present[k])
+
+
 def frame_positions(trace: LabelTrace) -> dict[int, int]:
     """The position (0..F-1) of every dataset frame index of the trace."""
     return {index: p for p, index in enumerate(trace.frame_index.tolist())}

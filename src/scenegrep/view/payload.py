@@ -2,7 +2,10 @@
 
 Columns stay columns (one JSON array per field, frames in CSR form: the rows of frame ``f``
 are ``offsets[f]:offsets[f + 1]``), rounded to centimetres and milliradians, so a 20 s
-recording with ten thousand observations is a few hundred kilobytes.
+recording with ten thousand observations is a few hundred kilobytes. An image view carries
+every camera channel (``boxes``: one such table per channel, the one to show first first,
+see :func:`.data.image_channels`), so the page can switch between them. Every colour comes
+from :mod:`.style` (kinds, classes, program names, behaviour sets), as in the pictures.
 """
 
 from __future__ import annotations
@@ -13,8 +16,8 @@ import numpy as np
 import shapely
 
 from ..model import LabelTrace, RoadMap
-from .data import TraceView
-from .style import MARKED_COLOUR, class_colours, program_colours
+from .data import TraceView, image_channels
+from .style import MARKED_COLOUR, behaviour_colours, category_colours, class_colours, program_colours
 
 DIGITS = 2
 """Decimals kept for metres, pixels and radians."""
@@ -47,7 +50,7 @@ def payload(view: TraceView) -> dict[str, Any]:
         "query": None if view.query is None else {"kind": view.query.kind, "text": view.query.text},
     }
     if view.image_space:
-        doc["boxes"] = _boxes(view)
+        doc["boxes"] = [_boxes(view, channel) for channel in image_channels(view)]
     else:
         doc["states"] = _states(view)
         doc["map"] = None if view.road_map is None else _map(view.road_map)
@@ -88,28 +91,29 @@ def _states(view: TraceView) -> dict[str, Any]:
         "width": _round(np.nan_to_num(st.width, nan=0.0)),
         "speed": _round(st.speed(), 1),
         "label_names": labels,
+        "label_colours": behaviour_colours(labels),
         "labels": codes,
         "marked": [] if view.marked is None else view.marked.astype(int).tolist(),
     }
 
 
-def _boxes(view: TraceView) -> dict[str, Any]:
-    """The boxes of the image channel that has the most of them, grouped by frame."""
+def _boxes(view: TraceView, channel_name: str) -> dict[str, Any]:
+    """The boxes of one image channel, grouped by frame, with the colour of every class."""
     assert view.trace.images is not None
     samples, boxes = view.trace.images.samples, view.trace.images.boxes
-    channel = int(np.argmax(np.bincount(samples.channel[boxes.sample], minlength=len(samples.channels))))
-    keep = samples.channel[boxes.sample] == channel
-    rows = np.flatnonzero(keep)
+    channel = samples.channels.index(channel_name)
+    rows = np.flatnonzero(samples.channel[boxes.sample] == channel)
     frames = samples.frame[boxes.sample[rows]]
     order = np.argsort(frames, kind="stable")
     rows, frames = rows[order], frames[order]
     sizes = samples.take(samples.channel == channel)
     marked = view.marked_boxes
     return {
-        "channel": samples.channels[channel],
+        "channel": channel_name,
         "image_size": [int(sizes.image_width.max(initial=0)), int(sizes.image_height.max(initial=0))],
         "offsets": np.searchsorted(frames, np.arange(view.trace.n_frames + 1)).tolist(),
         "classes": list(boxes.classes),
+        "class_colours": category_colours(boxes.classes),
         "class": boxes.category[rows].tolist(),
         "object": boxes.object[rows].tolist(),
         "cx": _round(boxes.cx[rows]),

@@ -1,10 +1,16 @@
-"""Colours shared by every view: one per canonical object kind, one per program name."""
+"""The one palette of every view (the HTML page, the PNG and the GIF draw from it alone).
+
+Objects and image boxes take the colour of their canonical kind (an image box without an
+object, its class's kind), corresponded objects the colour of their program name, behaviour
+label sets a colour per set; the HTML page receives these colours in its data and has no
+palette of its own.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
-from ..model.taxonomy import KINDS
+from ..model.taxonomy import KINDS, kind_of
 
 KIND_COLOURS = {
     "car": "#4c78a8",
@@ -26,6 +32,25 @@ PROGRAM_COLOURS = ("#e63946", "#f4a261", "#d62ad0", "#2a9d8f", "#ffb703", "#8338
 MARKED_COLOUR = "#ff7f0e"
 """Colour of observations of a class a SpRE names."""
 
+BEHAVIOUR_COLOURS = (
+    "#4c9be8",
+    "#9b5de5",
+    "#f15bb5",
+    "#00bbf9",
+    "#00f5d4",
+    "#fee440",
+    "#f8961e",
+    "#90be6d",
+    "#577590",
+    "#e76f51",
+    "#8ecae6",
+    "#b5838d",
+)
+"""Colours of the non-empty behaviour label sets, in the order of their codes (cycling)."""
+
+NO_BEHAVIOUR_COLOUR = "#dcdde1"
+"""Colour of frames where an object has no behaviour label (the empty set)."""
+
 
 def class_colours() -> dict[str, str]:
     """The colour of every kind."""
@@ -33,7 +58,26 @@ def class_colours() -> dict[str, str]:
     return dict(KIND_COLOURS)
 
 
+def category_colours(categories: Iterable[str]) -> list[str]:
+    """The colour of each class name as a dataset spells it: its canonical kind's."""
+    return [KIND_COLOURS[kind_of(category)] for category in categories]
+
+
 def program_colours(names: Iterable[str]) -> dict[str, str]:
     """A colour for every program name (``ego`` first), cycling through :data:`PROGRAM_COLOURS`."""
     ordered = sorted(dict.fromkeys(names), key=lambda n: (n != "ego", n))
     return {name: PROGRAM_COLOURS[k % len(PROGRAM_COLOURS)] for k, name in enumerate(ordered)}
+
+
+def behaviour_colours(sets: Sequence[str]) -> list[str]:
+    """The colour of each distinct behaviour label set, indexed by its code (the order of
+    ``BehaviourTable.distinct_sets``): the empty set :data:`NO_BEHAVIOUR_COLOUR`, the k-th
+    non-empty set ``BEHAVIOUR_COLOURS[k % 12]``."""
+    colours, k = [], 0
+    for labels in sets:
+        if labels:
+            colours.append(BEHAVIOUR_COLOURS[k % len(BEHAVIOUR_COLOURS)])
+            k += 1
+        else:
+            colours.append(NO_BEHAVIOUR_COLOUR)
+    return colours

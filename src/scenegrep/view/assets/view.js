@@ -6,15 +6,20 @@
   const data = JSON.parse(document.getElementById("scenegrep-data").textContent);
   const $ = (id) => document.getElementById(id);
   const nFrames = data.frames.index.length;
-  const rows = data.space === "image" ? data.boxes : data.states;
   const rowOfId = new Map(data.objects.id.map((id, k) => [id, k]));
-  const state = { frame: 0, match: -1, playing: null, view: { scale: 1, ox: 0, oy: 0 } };
+  const state = { frame: 0, match: -1, channel: 0, playing: null, view: { scale: 1, ox: 0, oy: 0 }, drawn: [] };
 
-  // Rows of every object, in frame order (for paths and the label rows of the time line).
-  const rowsOfObject = data.objects.id.map(() => []);
-  for (let r = 0; r < rows.object.length; r++) if (rows.object[r] >= 0) rowsOfObject[rows.object[r]].push(r);
-  const frameOfRow = new Int32Array(rows.object.length);
-  for (let f = 0; f < nFrames; f++) for (let r = rows.offsets[f]; r < rows.offsets[f + 1]; r++) frameOfRow[r] = f;
+  // The rows drawn: the states, or the boxes of the image channel shown (one table per channel).
+  let rows, rowsOfObject, frameOfRow;
+  function useRows(table) {
+    rows = table;
+    // Rows of every object, in frame order (for paths and the label rows of the time line).
+    rowsOfObject = data.objects.id.map(() => []);
+    for (let r = 0; r < rows.object.length; r++) if (rows.object[r] >= 0) rowsOfObject[rows.object[r]].push(r);
+    frameOfRow = new Int32Array(rows.object.length);
+    for (let f = 0; f < nFrames; f++) for (let r = rows.offsets[f]; r < rows.offsets[f + 1]; r++) frameOfRow[r] = f;
+  }
+  useRows(data.space === "image" ? data.boxes[0] : data.states);
 
   function currentMatch() { return state.match >= 0 ? data.matches[state.match] : null; }
 
@@ -64,7 +69,7 @@
     return [sx / v.scale + v.ox, (flipY ? canvas.height - sy : sy) / v.scale + v.oy];
   }
   function extent() {
-    if (data.space === "image") return [0, 0, data.boxes.image_size[0] || 1600, data.boxes.image_size[1] || 900];
+    if (data.space === "image") return [0, 0, rows.image_size[0] || 1600, rows.image_size[1] || 900];
     const m = currentMatch();
     const pick = m ? [...highlights().keys()].flatMap((o) => rowsOfObject[o]) : [...rows.x.keys()];
     const use = pick.length ? pick : [...rows.x.keys()];
@@ -106,7 +111,7 @@
     for (const ring of data.map.crosswalks) polygon(ring, "rgba(255, 255, 255, 0.85)", "#b0b6bf", 1);
   }
   function drawImageFrame() {
-    const [w, h] = data.boxes.image_size;
+    const [w, h] = rows.image_size;
     polygon([[0, 0], [w || 1600, 0], [w || 1600, h || 900], [0, h || 900]], "#20242a", "#888", 1);
   }
   function drawPaths(hl) {
@@ -124,14 +129,17 @@
   }
   function drawObjects(hl) {
     const labels = [];
+    state.drawn = [];
     const m = currentMatch();
     const inWindow = m && state.frame >= m.first && state.frame <= m.last;
     for (let r = rows.offsets[state.frame]; r < rows.offsets[state.frame + 1]; r++) {
       const o = rows.object[r];
       const name = o >= 0 ? hl.get(o) : undefined;
       const marked = inWindow && rows.marked.length && rows.marked[r];
-      const kindColour = o >= 0 ? data.objects.colour[o] : "#bdbdbd";
+      // an object's kind, else (an image box of no object) its class's kind
+      const kindColour = o >= 0 ? data.objects.colour[o] : rows.class_colours[rows.class[r]];
       const pts = corners(r);
+      state.drawn.push([r, name !== undefined ? data.program_colours[name] : kindColour]);
       if (name !== undefined) {
         polygon(pts, data.program_colours[name], "#111", 2);
         labels.push([pts, name]);
@@ -168,16 +176,13 @@
 
   // ---------------------------------------------------------------- time line
   const labelCanvas = $("labels"), lctx = labelCanvas.getContext("2d");
-  const LABEL_PALETTE = ["#4c9be8", "#9b5de5", "#f15bb5", "#00bbf9", "#00f5d4", "#fee440", "#f8961e", "#90be6d",
-    "#577590", "#e76f51", "#8ecae6", "#b5838d"];
-  function labelColour(code) { return code < 0 ? "#c8c8c8" : LABEL_PALETTE[code % LABEL_PALETTE.length]; }
   function drawLabelRows(hl, step, rowHeight) {
     const seen = new Set();
     hl.forEach(([o, name], k) => {
       for (const r of rowsOfObject[o]) {
-        const code = data.states && data.states.labels.length ? data.states.labels[r] : -1;
+        const code = rows.labels[r];
         seen.add(code);
-        lctx.fillStyle = labelColour(code);
+        lctx.fillStyle = rows.label_colours[code];
         lctx.fillRect(frameOfRow[r] * step, k * rowHeight + 1, Math.ceil(step), rowHeight - 2);
       }
       lctx.fillStyle = "#111"; lctx.font = "bold 11px system-ui, sans-serif";
@@ -187,8 +192,8 @@
     legend.replaceChildren();
     for (const code of [...seen].sort((a, b) => a - b)) {
       const item = document.createElement("span");
-      const sw = document.createElement("i"); sw.style.background = labelColour(code);
-      item.append(sw, code >= 0 ? data.states.label_names[code] || "(none)" : "(no labels)");
+      const sw = document.createElement("i"); sw.style.background = rows.label_colours[code];
+      item.append(sw, rows.label_names[code] || "(none)");
       legend.append(item);
     }
   }
@@ -216,7 +221,9 @@
     lctx.fillStyle = "#f0f1f3"; lctx.fillRect(0, 0, labelCanvas.width, labelCanvas.height);
     const hl = [...highlights()];
     const step = labelCanvas.width / nFrames;
-    if (hl.length) drawLabelRows(hl, step, labelCanvas.height / hl.length); else drawCounts(step);
+    // label rows of the corresponded objects where the trace has behaviour labels, as the pictures
+    if (hl.length && data.space !== "image" && rows.labels.length) drawLabelRows(hl, step, labelCanvas.height / hl.length);
+    else drawCounts(step);
     const m = currentMatch(), mark = $("window-mark");
     mark.hidden = !m;
     if (m) {
@@ -284,6 +291,23 @@
     });
     if (!data.matches.length) $("match-choice").hidden = true;
     select.addEventListener("change", () => showMatch(Number(select.value)));
+    const channels = $("channel");
+    if (data.space === "image") {
+      data.boxes.forEach((table, k) => {
+        const o = document.createElement("option"); o.value = String(k); o.textContent = table.channel;
+        channels.append(o);
+      });
+      channels.disabled = data.boxes.length < 2;
+      channels.addEventListener("change", () => showChannel(Number(channels.value)));
+    } else {
+      $("channel-choice").hidden = true;
+    }
+  }
+  function showChannel(k) {
+    state.channel = Math.max(0, Math.min(data.boxes.length - 1, k));
+    useRows(data.boxes[state.channel]);
+    $("channel").value = String(state.channel);
+    fit(); drawTimeline(); draw();
   }
 
   // ---------------------------------------------------------------- interaction
@@ -324,7 +348,7 @@
     if (name !== undefined) lines.push(`${name} (program object)`);
     if (o >= 0) lines.push(`id ${data.objects.id[o]}`, `class ${data.objects.category[o]} (${data.objects.kind[o]})`);
     if (data.space === "image") {
-      lines.push(`class ${data.boxes.classes[rows.class[r]]}`, `centre ${rows.cx[r]}, ${rows.cy[r]} px`,
+      lines.push(`class ${rows.classes[rows.class[r]]}`, `centre ${rows.cx[r]}, ${rows.cy[r]} px`,
         `size ${rows.w[r]} x ${rows.h[r]} px`, `score ${rows.score[r]}`);
     } else {
       lines.push(`position ${rows.x[r]}, ${rows.y[r]} m`, `heading ${(rows.heading[r] * 180 / Math.PI).toFixed(1)} deg`,
@@ -383,6 +407,10 @@
     frame: () => data.frames.index[state.frame],
     setFrame,
     match: () => (currentMatch() ? currentMatch().number : null),
+    channel: () => (data.space === "image" ? rows.channel : null),
+    setChannel: (name) => showChannel(data.boxes.findIndex((table) => table.channel === name)),
+    // [row, colour] of every box drawn in the frame shown: its program name's, kind's or class's colour
+    drawnColours: () => state.drawn.map(([r, colour]) => [r, colour]),
     window: () => { const m = currentMatch(); return m ? [data.frames.index[m.first], data.frames.index[m.last]] : null; },
     highlighted: () => {
       const hl = highlights(), out = [];

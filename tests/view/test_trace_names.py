@@ -112,11 +112,17 @@ def test_show_draws_the_trace_of_a_printed_match_line(printed, tmp_path, capsys)
     assert capsys.readouterr().err.startswith(f"scenegrep: match 0 of {name} drawn in ")
 
 
-@pytest.mark.parametrize("field", ["trace_id", "name", "source"])
-def test_show_accepts_the_json_rows_names(printed, field, tmp_path, capsys):
+def test_the_json_rows_names_mean_their_trace(printed, tmp_path, capsys):
+    """Every name a JSON row gives means its trace in the results file; ``show`` draws one."""
+    from scenegrep.dataset.results import Results
+
     results, _, json_rows = printed
+    table = Results.read(results).table.to_pylist()
+    for row in json_rows:
+        for field in ("trace_id", "name", "source"):
+            assert choose_trace(table, row[field]) == TraceChoice(row["trace_id"])
     row = json_rows[2]
-    assert main(["show", str(results), "--trace", row[field], "-o", str(tmp_path / "t.png")]) == 0
+    assert main(["show", str(results), "--trace", row["source"], "-o", str(tmp_path / "t.png")]) == 0
     assert f"match 0 of {row['name']} drawn" in capsys.readouterr().err
 
 

@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from scenegrep.scene.decide import Tolerance
+from scenegrep.scene.tolerance import Tolerance
 from scenegrep.scene.geometry import GEOMETRY_CACHE_SIZE, MapGeometry, geometry_of
 from scenegrep.scene.regions import MapField, MapRegion, Sector
 from scenegrep.scene.shapes import points_in_sector

@@ -17,7 +17,8 @@ from functools import cached_property
 import numpy as np
 
 from ..model import LabelTrace
-from ..scene.decide import Tolerance, decide
+from ..scene.decide import decide
+from ..scene.tolerance import Tolerance
 from ..scene.dependencies import Group, random_leaves
 from ..scene.evaluate import Evaluator, Labels, Rows
 from ..scene.geometry import MapGeometry

@@ -21,7 +21,7 @@ import numpy as np
 from ..errors import UserError, at
 from ..model import LabelTrace, RoadMap
 from ..model.layers import UnknownLayers
-from ..scene.decide import Tolerance
+from ..scene.tolerance import Tolerance
 from ..scene.dependencies import analyse, completed_groups
 from ..scene.geometry import geometry_of
 from ..scene.match import SceneOptions, labels_of, match_trace

@@ -6,7 +6,7 @@ over all frames (:mod:`.match`), each group decided by closed forms
 (:mod:`.decide`) or the solvers (:mod:`.solvers`).
 """
 
-from .decide import Tolerance
+from .tolerance import Tolerance
 from .match import SceneOptions
 from .query import SceneQuery, SceneResult, compile_scene, load_scene
 

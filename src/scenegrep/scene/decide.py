@@ -22,42 +22,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import UserError
 from .dependencies import Group
 from .evaluate import Affine, Evaluator, NotAffine
-from .program import ANGULAR_SPEED_FEATURE, SPEED_FEATURES, Feature
+from .solvers import decide_rows
 from .terms import Term
+from .tolerance import Tolerance
 
 TWO_PI = 2 * np.pi
-
-
-@dataclass(frozen=True)
-class Tolerance:
-    """Per-feature tolerances: positions and sizes in metres, headings in radians (angular speeds
-    in radians per second), speeds and velocity components in metres per second."""
-
-    position: float = 1e-6
-    heading: float = 1e-6
-    speed: float = 1e-6
-
-    def of(self, feature: Feature) -> float:
-        """The tolerance a feature is compared with."""
-        return float(getattr(self, self.name_of(feature)))
-
-    @staticmethod
-    def name_of(feature: Feature) -> str:
-        """The name of the tolerance (a field of this class) a feature is compared with: speed for
-        speeds and velocity components, heading for headings and angular speeds, else position."""
-        if feature.name in SPEED_FEATURES:
-            return "speed"
-        return "heading" if feature.is_angle or feature.name == ANGULAR_SPEED_FEATURE else "position"
-
-    @classmethod
-    def checked(cls, position: float, heading: float, speed: float = 1e-6) -> Tolerance:
-        """Tolerances a user gave (UserError if any is negative)."""
-        if position < 0 or heading < 0 or speed < 0:
-            raise UserError("tolerances must not be negative")
-        return cls(position, heading, speed)
 
 
 @dataclass
@@ -75,13 +46,13 @@ def decide(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
     for leaf in sorted((u for u in group.unknowns if u.op == "choice"), key=repr):
         ev.expand_choice(leaf)
     ev.unknowns = frozenset(u for u in group.unknowns if u.op != "choice")
-    ok = _decide_expanded(ev, group, tolerance)
+    ok = decide_expanded(ev, group, tolerance)
     found = np.zeros(len(ev.rows), dtype=bool)
     found[ev.origin[ok]] = True
     return found
 
 
-def _decide_expanded(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
+def decide_expanded(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.ndarray:
     if not ev.unknowns:
         return _direct(ev, group, tolerance)
     try:
@@ -97,8 +68,6 @@ def _decide_expanded(ev: Evaluator, group: Group, tolerance: Tolerance) -> np.nd
         pinned = _pinned_point(ev, linear, points)
         if pinned is not None:
             return pinned
-    from .solvers import decide_rows
-
     return decide_rows(ev, group, tolerance)
 
 

@@ -23,9 +23,11 @@ from ..errors import UserError, at
 from ..model import LabelTrace
 from ..model.geometry import heading_of_vector, normalize_angle
 from ..model.kinematics import ESTIMATED_VELOCITY, finite_difference_acceleration
+from .follow import walk_end
 from .geometry import MapGeometry
 from .program import TRACE, ProgramObject
 from .regions import Region
+from .shapes import boxes_overlap
 from .terms import Term
 
 
@@ -301,16 +303,14 @@ class Evaluator:
             grow = 2 * self.position_tolerance * ease
             return self.geometry.boxes_meet_oriented(region, x, y, h, _size(length + grow), _size(width + grow), value)
         if op == "boxes_overlap":
-            from .shapes import boxes_overlap
-
             grow = 2 * self.position_tolerance * args[10]
             a = (*args[:3], _size(args[3] + grow), _size(args[4] + grow))
             b = (*args[5:8], _size(args[8] + grow), _size(args[9] + grow))
             return boxes_overlap(a, b)
-        if op == "follow":
-            from .follow import follow_field
-
-            return follow_field(self, term)
+        if op == "follow":  # one coordinate (term.value[1]: 0 = x, 1 = y) of the walk's end
+            x, y, distance = self._args(term)
+            field, axis = term.value
+            return walk_end(self.geometry, field, x, y, distance, self.value)[axis]
         raise ValueError(f"cannot evaluate {op}")
 
     def _field(self, term: Term) -> np.ndarray:

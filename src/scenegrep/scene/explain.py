@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from .decide import Tolerance, _decide_expanded, closed_form_witness, decide
+from .decide import closed_form_witness, decide, decide_expanded
+from .tolerance import Tolerance
 from .dependencies import Group, random_leaves
 from .evaluate import Evaluator, Labels, Rows
 from .geometry import MapGeometry
@@ -54,7 +55,7 @@ def _group_witness(ev: Evaluator, group: Group, tolerance: Tolerance, names: dic
     for leaf in choices:
         ev.expand_choice(leaf)
     ev.unknowns = frozenset(u for u in group.unknowns if u.op != "choice")
-    feasible = np.flatnonzero(_decide_expanded(ev, group, tolerance))
+    feasible = np.flatnonzero(decide_expanded(ev, group, tolerance))
     if not len(feasible):
         return {}
     row = int(feasible[0])

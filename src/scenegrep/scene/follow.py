@@ -12,16 +12,11 @@ have in the box.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import UserError
 from .geometry import SMALL_BOX_M
-from .terms import Term
-
-if TYPE_CHECKING:
-    from .evaluate import Evaluator
 
 MIN_STEPS = 4
 """Scenic's minimum number of steps (``VectorField.minSteps``)."""
@@ -44,14 +39,6 @@ def steps_for(distance) -> np.ndarray:
             f" ({MAX_STEPS} of Scenic's {STEP_M:g} m steps) is not supported: bound the distance"
         )
     return np.maximum(MIN_STEPS, np.ceil(scaled)).astype(np.intp)
-
-
-def follow_field(ev: Evaluator, term: Term) -> np.ndarray:
-    """One coordinate (``term.value[1]``: 0 = x, 1 = y) of the walk's end, for every row."""
-    x, y, distance = ev._args(term)
-    field, axis = term.value
-    end = walk_end(ev.geometry, field, x, y, distance, ev.value)
-    return end[0] if axis == 0 else end[1]
 
 
 def walk_end(geometry, field, x, y, distance, value) -> tuple[np.ndarray, np.ndarray]:

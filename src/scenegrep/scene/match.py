@@ -25,7 +25,8 @@ import numpy as np
 
 from ..model import LabelTrace
 from ..model.layers import UnknownLayers
-from .decide import Tolerance, decide
+from .decide import decide
+from .tolerance import Tolerance
 from .dependencies import Group
 from .evaluate import Evaluator, Labels, Rows
 from .geometry import MapGeometry

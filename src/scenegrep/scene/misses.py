@@ -1,7 +1,7 @@
 """Nearest misses of a scene query that matched nothing: the smallest tolerances that admit a frame.
 
 Matching is monotone in every tolerance: a feature passes when ``|term - label| <= t`` and box
-predicates are eased by t only in the lenient direction (:mod:`.tolerance`), so a wider tolerance
+predicates are eased by t only in the lenient direction (:mod:`.lenient_boxes`), so a wider tolerance
 never rejects a correspondence a narrower one admits. The search is a bisection over the examined
 frames of a trace at once, each step one run of the matcher (:func:`.match.match_trace`):
 
@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .decide import Tolerance
+from .tolerance import Tolerance
 from .match import TraceMatches, match_trace
 
 if TYPE_CHECKING:

@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import fields, replace
 
 from ..errors import UserError
-from .decide import Tolerance
+from .tolerance import Tolerance
 
 PROFILES: dict[str, Tolerance] = {
     "exact": Tolerance(),

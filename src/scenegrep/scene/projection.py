@@ -30,7 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from .decide import Tolerance, _decide_expanded, closed_form_intervals
+from .decide import closed_form_intervals, decide_expanded
+from .tolerance import Tolerance
 from .dependencies import Group
 from .evaluate import Evaluator, Labels
 from .geometry import MapGeometry
@@ -141,7 +142,7 @@ def _group_values(ev: Evaluator, group: Group, tolerance: Tolerance, slot: np.nd
     for leaf in choices:
         ev.expand_choice(leaf)
     ev.unknowns = frozenset(u for u in group.unknowns if u.op != "choice")
-    feasible = np.flatnonzero(_decide_expanded(ev, group, tolerance))
+    feasible = np.flatnonzero(decide_expanded(ev, group, tolerance))
     where = slot[ev.origin[feasible]]
     for leaf in choices:
         hulls.choose(leaf, where, ev.memo[leaf][feasible])

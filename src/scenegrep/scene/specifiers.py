@@ -45,7 +45,7 @@ from .regions import (
     orientation_of,
 )
 from .terms import RandomPoint, RandomVariable, Term
-from .tolerance import eased
+from .lenient_boxes import eased
 from .values import Delayed, Instance, SelfView, Vec, observed_view, type_name
 
 if TYPE_CHECKING:

@@ -1,41 +1,38 @@
-"""How the position tolerance enters Scenic's implicit requirements about boxes: leniently.
-
-A labeled position is known up to the position tolerance t, so an implicit requirement (no
-collision, containment in ``regionContainedIn``, visibility) holds when it holds for *some*
-positions within t of the labels. (The ``require`` statements a program states are evaluated on
-the labeled values exactly: their box predicates keep ease 0.) For the predicates on object
-boxes this means, by where they occur in the requirement:
-
-* in positive position (under an even number of ``not``): lenient — a box is shrunk by t on
-  every side to test that it lies inside a region, grown by t to test that it meets another box
-  or a view sector;
-* in negative position: strict — the other way round, so ``not`` of the predicate is lenient;
-* anywhere else (a condition inside ``X if C else Y``): exactly as labeled.
-
-:func:`eased` sets each box predicate's last argument, its *ease*, to +1, -1 or 0; the evaluator
-adjusts the box sizes by ``2 t ease`` (grow) or ``-2 t ease`` (shrink) accordingly.
-"""
+"""The tolerances labelled features are compared with, per kind of feature (a feature of the
+program and its labelled value agree when they differ by at most the tolerance)."""
 
 from __future__ import annotations
 
-from .terms import Term, TermFactory
+from dataclasses import dataclass
 
-BOX_PREDICATES = ("box_in_region", "boxes_overlap", "box_visible")
+from ..errors import UserError
+from .program import ANGULAR_SPEED_FEATURE, SPEED_FEATURES, Feature
 
 
-def eased(f: TermFactory, term: Term, polarity: int = 1, memo: dict | None = None) -> Term:
-    """The condition with every box predicate's ease set by its polarity (see the module docstring)."""
-    memo = {} if memo is None else memo
-    key = (id(term), polarity)
-    if key in memo:
-        return memo[key]
-    if term.op in BOX_PREDICATES:
-        result = f.op(term.op, *term.args[:-1], f.const(polarity), value=term.value, kind=term.kind)
-    elif term.op in ("and", "or"):
-        result = f.op(term.op, *(eased(f, a, polarity, memo) for a in term.args), kind=term.kind)
-    elif term.op == "not":
-        result = f.op("not", eased(f, term.args[0], -polarity, memo), kind=term.kind)
-    else:
-        result = term
-    memo[key] = result
-    return result
+@dataclass(frozen=True)
+class Tolerance:
+    """Per-feature tolerances: positions and sizes in metres, headings in radians (angular speeds
+    in radians per second), speeds and velocity components in metres per second."""
+
+    position: float = 1e-6
+    heading: float = 1e-6
+    speed: float = 1e-6
+
+    def of(self, feature: Feature) -> float:
+        """The tolerance a feature is compared with."""
+        return float(getattr(self, self.name_of(feature)))
+
+    @staticmethod
+    def name_of(feature: Feature) -> str:
+        """The name of the tolerance (a field of this class) a feature is compared with: speed for
+        speeds and velocity components, heading for headings and angular speeds, else position."""
+        if feature.name in SPEED_FEATURES:
+            return "speed"
+        return "heading" if feature.is_angle or feature.name == ANGULAR_SPEED_FEATURE else "position"
+
+    @classmethod
+    def checked(cls, position: float, heading: float, speed: float = 1e-6) -> Tolerance:
+        """Tolerances a user gave (UserError if any is negative)."""
+        if position < 0 or heading < 0 or speed < 0:
+            raise UserError("tolerances must not be negative")
+        return cls(position, heading, speed)

@@ -31,7 +31,7 @@ from __future__ import annotations
 import numpy as np
 import shapely
 
-from ..decide import Tolerance
+from ..tolerance import Tolerance
 from ..dependencies import Group
 from ..evaluate import Evaluator
 from ..geometry import MapGeometry

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass, field, fields, is_dataclass, replace
 from typing import Any
 
-from ..decide import Tolerance
+from ..tolerance import Tolerance
 from ..dependencies import Group
 from ..evaluate import Evaluator
 from ..regions import Field, Region

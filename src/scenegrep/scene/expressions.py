@@ -10,16 +10,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..scenic import ir
 from . import vectors as V
-from .regions import Difference, Field, Intersection, LaneAt, Region, Sector, Union
+from .context import Context
+from .domain import CLASSES
+from .regions import Difference, Everywhere, Field, Intersection, LaneAt, Region, Sector, Union
 from .terms import FiniteChoice, RandomVariable, Term
 from .values import Delayed, Instance, Namespace, SelfView, Vec, type_name
-
-if TYPE_CHECKING:
-    from .resolve import Resolver
 
 DEG = math.pi / 180
 MAX_CHOICES = 32
@@ -29,7 +28,7 @@ _BINARY = {"+": "add", "-": "sub", "*": "mul", "/": "div"}
 _COMPARE = {"<": ("lt", False), "<=": ("le", False), ">": ("lt", True), ">=": ("le", True), "==": ("eq", False)}
 
 
-def evaluate(r: Resolver, node: ir.Node) -> Any:
+def evaluate(r: Context, node: ir.Node) -> Any:
     """The value of an IR expression."""
     handler = _HANDLERS.get(type(node))
     if handler is None:
@@ -38,19 +37,19 @@ def evaluate(r: Resolver, node: ir.Node) -> Any:
 
 
 # ---------------------------------------------------------------------------- coercions
-def to_num(r: Resolver, value: Any, node: ir.Node, what: str = "a number") -> Term:
+def to_num(r: Context, value: Any, node: ir.Node, what: str = "a number") -> Term:
     if isinstance(value, Term) and value.kind == "num":
         return value
     raise r.error(f"expected {what}, got {type_name(value)}", node)
 
 
-def to_bool(r: Resolver, value: Any, node: ir.Node) -> Term:
+def to_bool(r: Context, value: Any, node: ir.Node) -> Term:
     if isinstance(value, Term) and value.kind == "bool":
         return value
     raise r.error(f"expected a condition, got {type_name(value)}", node)
 
 
-def to_vec(r: Resolver, value: Any, node: ir.Node) -> Vec:
+def to_vec(r: Context, value: Any, node: ir.Node) -> Vec:
     """A vector: a Vec, an object's or point's position, or a 2-sequence of numbers."""
     if isinstance(value, Vec):
         return value
@@ -61,14 +60,14 @@ def to_vec(r: Resolver, value: Any, node: ir.Node) -> Vec:
     raise r.error(f"expected a vector, got {type_name(value)}", node)
 
 
-def to_heading(r: Resolver, value: Any, node: ir.Node) -> Term:
+def to_heading(r: Context, value: Any, node: ir.Node) -> Term:
     """A heading: a number (radians) or an oriented point's or object's heading."""
     if isinstance(value, Instance) and value.spec.name != "Point":
         return value.get("heading")
     return to_num(r, value, node, "a heading")
 
 
-def to_region(r: Resolver, value: Any, node: ir.Node) -> Region:
+def to_region(r: Context, value: Any, node: ir.Node) -> Region:
     if isinstance(value, Region):
         return value
     raise r.error(f"expected a region, got {type_name(value)}", node)
@@ -79,7 +78,7 @@ def is_oriented(value: Any) -> bool:
     return isinstance(value, Instance) and value.spec.name != "Point"
 
 
-def visible_region(r: Resolver, value: Any, node: ir.Node) -> Sector:
+def visible_region(r: Context, value: Any, node: ir.Node) -> Sector:
     """The 2-D visible region of a point (a disc) or oriented point/object (a sector)."""
     if not isinstance(value, Instance):
         raise r.error(f"expected a point or object, got {type_name(value)}", node)
@@ -91,28 +90,28 @@ def visible_region(r: Resolver, value: Any, node: ir.Node) -> Sector:
 
 
 # ---------------------------------------------------------------------------- Python expressions
-def _constant(r: Resolver, node: ir.Constant) -> Any:
+def _constant(r: Context, node: ir.Constant) -> Any:
     if isinstance(node.value, int) and not isinstance(node.value, bool):
         return r.f.const(float(node.value))
     return r.f.const(node.value)
 
 
-def _name(r: Resolver, node: ir.Name) -> Any:
+def _name(r: Context, node: ir.Name) -> Any:
     return r.lookup(node)
 
 
-def _sequence(r: Resolver, node: ir.Sequence) -> Any:
+def _sequence(r: Context, node: ir.Sequence) -> Any:
     items = tuple(evaluate(r, item) for item in node.items)
     if len(items) == 2 and all(isinstance(i, Term) and i.kind == "num" for i in items):
         return Vec(items[0], items[1])
     return items
 
 
-def _mapping(r: Resolver, node: ir.Mapping) -> Any:
+def _mapping(r: Context, node: ir.Mapping) -> Any:
     return {k: evaluate(r, v) for k, v in zip(node.keys, node.values)}
 
 
-def _unary(r: Resolver, node: ir.Unary) -> Any:
+def _unary(r: Context, node: ir.Unary) -> Any:
     value = evaluate(r, node.operand)
     if node.op == "not":
         return r.f.op("not", to_bool(r, value, node.operand), kind="bool")
@@ -122,7 +121,7 @@ def _unary(r: Resolver, node: ir.Unary) -> Any:
     return number if node.op == "+" else r.f.op("neg", number)
 
 
-def _binary(r: Resolver, node: ir.Binary) -> Any:
+def _binary(r: Context, node: ir.Binary) -> Any:
     left, right = evaluate(r, node.left), evaluate(r, node.right)
     if isinstance(left, Delayed) or isinstance(right, Delayed):
         return _delayed_binary(r, node, left, right)
@@ -138,7 +137,7 @@ def _binary(r: Resolver, node: ir.Binary) -> Any:
     return r.f.op(_BINARY[node.op], to_num(r, left, node.left), to_num(r, right, node.right))
 
 
-def _vector_arithmetic(r: Resolver, node: ir.Binary, left: Any, right: Any) -> Vec:
+def _vector_arithmetic(r: Context, node: ir.Binary, left: Any, right: Any) -> Vec:
     if node.op in "+-":
         a, b = to_vec(r, left, node.left), to_vec(r, right, node.right)
         return V.add(r.f, a, b) if node.op == "+" else V.sub(r.f, a, b)
@@ -151,7 +150,7 @@ def _vector_arithmetic(r: Resolver, node: ir.Binary, left: Any, right: Any) -> V
     raise r.error(f"cannot apply {node.op} to {type_name(left)} and {type_name(right)}", node)
 
 
-def _delayed_binary(r: Resolver, node: ir.Binary, left: Any, right: Any) -> Delayed:
+def _delayed_binary(r: Context, node: ir.Binary, left: Any, right: Any) -> Delayed:
     def compute(view: Any) -> Any:
         a = left.compute(view) if isinstance(left, Delayed) else left
         b = right.compute(view) if isinstance(right, Delayed) else right
@@ -162,7 +161,7 @@ def _delayed_binary(r: Resolver, node: ir.Binary, left: Any, right: Any) -> Dela
     return Delayed(compute, "a heading relative to a field")
 
 
-def _compare(r: Resolver, node: ir.Compare) -> Term:
+def _compare(r: Context, node: ir.Compare) -> Term:
     left, right = evaluate(r, node.left), evaluate(r, node.right)
     if node.op in ("in", "not in"):
         inside = _contains(r, node, left, right)
@@ -177,7 +176,7 @@ def _compare(r: Resolver, node: ir.Compare) -> Term:
     return r.f.op(op, *((b, a) if swap else (a, b)), kind="bool")
 
 
-def _contains(r: Resolver, node: ir.Compare, thing: Any, region: Any) -> Term:
+def _contains(r: Context, node: ir.Compare, thing: Any, region: Any) -> Term:
     """``X in R``: an object's box is inside R (Scenic's containsObject), a point lies in R."""
     area = to_region(r, region, node.right)
     if isinstance(thing, Instance) and thing.is_object:
@@ -186,7 +185,7 @@ def _contains(r: Resolver, node: ir.Compare, thing: Any, region: Any) -> Term:
     return r.f.op("in_region", point.x, point.y, value=area, kind="bool")
 
 
-def EXACT(r: Resolver) -> Term:  # noqa: N802 - a constant
+def EXACT(r: Context) -> Term:  # noqa: N802 - a constant
     """The 'ease' argument of a box predicate before :func:`.tolerance.eased` sets it (0: exact)."""
     return r.f.const(0)
 
@@ -197,7 +196,7 @@ def box_terms(obj: Instance) -> tuple[Term, Term, Term, Term, Term]:
     return position.x, position.y, obj.get("heading"), obj.get("length"), obj.get("width")
 
 
-def _bool_op(r: Resolver, node: ir.BoolOp) -> Term:
+def _bool_op(r: Context, node: ir.BoolOp) -> Term:
     terms = [to_bool(r, evaluate(r, operand), operand) for operand in node.operands]
     result = terms[0]
     for term in terms[1:]:
@@ -205,7 +204,7 @@ def _bool_op(r: Resolver, node: ir.BoolOp) -> Term:
     return result
 
 
-def _conditional(r: Resolver, node: ir.Conditional) -> Term:
+def _conditional(r: Context, node: ir.Conditional) -> Term:
     test = to_bool(r, evaluate(r, node.test), node.test)
     body, orelse = evaluate(r, node.body), evaluate(r, node.orelse)
     if not (isinstance(body, Term) and isinstance(orelse, Term) and body.kind == orelse.kind):
@@ -213,7 +212,7 @@ def _conditional(r: Resolver, node: ir.Conditional) -> Term:
     return r.f.op("ite", test, body, orelse, kind=body.kind)
 
 
-def _attribute(r: Resolver, node: ir.Attribute) -> Any:
+def _attribute(r: Context, node: ir.Attribute) -> Any:
     value = evaluate(r, node.value)
     if isinstance(value, Namespace):
         if node.attr not in value.attributes:
@@ -228,7 +227,7 @@ def _attribute(r: Resolver, node: ir.Attribute) -> Any:
     raise r.error(f"{type_name(value)} has no attribute {node.attr!r}", node)
 
 
-def _property(r: Resolver, node: ir.Attribute, obj: Instance) -> Any:
+def _property(r: Context, node: ir.Attribute, obj: Instance) -> Any:
     attr = node.attr
     if attr == "lane":
         position = obj.get("position")
@@ -241,7 +240,7 @@ def _property(r: Resolver, node: ir.Attribute, obj: Instance) -> Any:
 
 
 # ---------------------------------------------------------------------------- calls and distributions
-def _call(r: Resolver, node: ir.Call) -> Any:
+def _call(r: Context, node: ir.Call) -> Any:
     handler = _CALLS.get(node.function)
     if handler is None:
         raise r.error(f"unknown or unsupported function {node.function!r}", node)
@@ -250,17 +249,17 @@ def _call(r: Resolver, node: ir.Call) -> Any:
     return handler(r, node, [evaluate(r, a) for a in node.args])
 
 
-def _arity(r: Resolver, node: ir.Call, args: list[Any], *counts: int) -> None:
+def _arity(r: Context, node: ir.Call, args: list[Any], *counts: int) -> None:
     if len(args) not in counts:
         expected = " or ".join(str(c) for c in counts)
         raise r.error(f"{node.function} takes {expected} arguments, got {len(args)}", node)
 
 
-def _variable(r: Resolver, node: ir.Call, low: Term, high: Term) -> Term:
+def _variable(r: Context, node: ir.Call, low: Term, high: Term) -> Term:
     return r.f.var(RandomVariable(r.label(node), low, high, node.span))
 
 
-def _range(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
+def _range(r: Context, node: ir.Call, args: list[Any]) -> Term:
     _arity(r, node, args, 2)
     low, high = (to_num(r, a, n) for a, n in zip(args, node.args))
     if low.is_const and high.is_const and low.value > high.value:
@@ -268,20 +267,20 @@ def _range(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
     return _variable(r, node, low, high)
 
 
-def _normal(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
+def _normal(r: Context, node: ir.Call, args: list[Any]) -> Term:
     _arity(r, node, args, 2)
     for a, n in zip(args, node.args):
         to_num(r, a, n)
     return _variable(r, node, r.f.const(-math.inf), r.f.const(math.inf))
 
 
-def _truncated_normal(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
+def _truncated_normal(r: Context, node: ir.Call, args: list[Any]) -> Term:
     _arity(r, node, args, 4)
     low, high = (to_num(r, a, n) for a, n in zip(args[2:], node.args[2:]))
     return _variable(r, node, low, high)
 
 
-def _options(r: Resolver, node: ir.Call, args: list[Any]) -> Any:
+def _options(r: Context, node: ir.Call, args: list[Any]) -> Any:
     _arity(r, node, args, 1)
     values = args[0]
     if isinstance(values, dict):
@@ -297,13 +296,13 @@ def _options(r: Resolver, node: ir.Call, args: list[Any]) -> Any:
     return choose(r, node, values)
 
 
-def _uniform(r: Resolver, node: ir.Call, args: list[Any]) -> Any:
+def _uniform(r: Context, node: ir.Call, args: list[Any]) -> Any:
     if not args:
         raise r.error("Uniform takes at least one value", node)
     return choose(r, node, tuple(args))
 
 
-def _discrete_range(r: Resolver, node: ir.Call, args: list[Any]) -> Any:
+def _discrete_range(r: Context, node: ir.Call, args: list[Any]) -> Any:
     _arity(r, node, args, 2)
     low, high = (to_num(r, a, n) for a, n in zip(args, node.args))
     if not (low.is_const and high.is_const and float(low.value).is_integer() and float(high.value).is_integer()):
@@ -313,7 +312,7 @@ def _discrete_range(r: Resolver, node: ir.Call, args: list[Any]) -> Any:
     return choose(r, node, tuple(r.f.const(v) for v in range(int(low.value), int(high.value) + 1)))
 
 
-def choose(r: Resolver, node: ir.Node, values: tuple[Any, ...]) -> Any:
+def choose(r: Context, node: ir.Node, values: tuple[Any, ...]) -> Any:
     """A random choice among values: numbers, strings, booleans, vectors or regions (one shared index)."""
     if len(values) == 1:
         return values[0]
@@ -330,7 +329,7 @@ def choose(r: Resolver, node: ir.Node, values: tuple[Any, ...]) -> Any:
     raise r.error("Options/Uniform over values of different or unsupported types", node)
 
 
-def _minmax(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
+def _minmax(r: Context, node: ir.Call, args: list[Any]) -> Term:
     if len(args) < 2:
         raise r.error(f"{node.function} takes at least two numbers", node)
     terms = [to_num(r, a, n) for a, n in zip(args, node.args)]
@@ -340,12 +339,12 @@ def _minmax(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
     return result
 
 
-def _abs(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
+def _abs(r: Context, node: ir.Call, args: list[Any]) -> Term:
     _arity(r, node, args, 1)
     return r.f.op("abs", to_num(r, args[0], node.args[0]))
 
 
-def _relative_speed(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
+def _relative_speed(r: Context, node: ir.Call, args: list[Any]) -> Term:
     """``RelativeSpeed(X[, Y])``, scenegrep's extension (Scenic 3.1.1 has no such operator):
     |X.velocity - Y.velocity| in m/s, Y the ego when omitted, X and Y scene objects."""
     _arity(r, node, args, 1, 2)
@@ -358,14 +357,14 @@ def _relative_speed(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
     return V.norm(r.f, V.sub(r.f, objects[0].get("velocity"), objects[1].get("velocity")))
 
 
-def _local_path(r: Resolver, node: ir.Call, args: list[Any]) -> Term:
+def _local_path(r: Context, node: ir.Call, args: list[Any]) -> Term:
     _arity(r, node, args, 1)
     if not (isinstance(args[0], Term) and args[0].kind == "str"):
         raise r.error("localPath takes a file name", node)
     return r.f.const(r.local_path(args[0].value))
 
 
-_CALLS: dict[str, Callable[[Resolver, ir.Call, list[Any]], Any]] = {
+_CALLS: dict[str, Callable[[Context, ir.Call, list[Any]], Any]] = {
     "Range": _range,
     "Normal": _normal,
     "TruncatedNormal": _truncated_normal,
@@ -382,7 +381,7 @@ _CALLS: dict[str, Callable[[Resolver, ir.Call, list[Any]], Any]] = {
 
 
 # ---------------------------------------------------------------------------- Scenic operators
-def _operator(r: Resolver, node: ir.Operator) -> Any:
+def _operator(r: Context, node: ir.Operator) -> Any:
     operands = [None if o is None else evaluate(r, o) for o in node.operands]
     return _OPERATORS[node.name](r, node, operands)
 
@@ -391,26 +390,26 @@ def _operand(node: ir.Operator, i: int) -> ir.Node:
     return node.operands[i] or node
 
 
-def _deg(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _deg(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     return r.f.op("mul", to_num(r, ops[0], _operand(node, 0)), r.f.const(DEG))
 
 
-def _vector(r: Resolver, node: ir.Operator, ops: list[Any]) -> Vec:
+def _vector(r: Context, node: ir.Operator, ops: list[Any]) -> Vec:
     return Vec(to_num(r, ops[0], _operand(node, 0)), to_num(r, ops[1], _operand(node, 1)))
 
 
-def field_at(r: Resolver, field: Field, point: Vec) -> Term:
+def field_at(r: Context, field: Field, point: Vec) -> Term:
     """The heading of a field at a point."""
     return r.f.op("field", point.x, point.y, value=field)
 
 
-def _field_at(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _field_at(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     if not isinstance(ops[0], Field):
         raise r.error(f"expected a vector field, got {type_name(ops[0])}", _operand(node, 0))
     return field_at(r, ops[0], to_vec(r, ops[1], _operand(node, 1)))
 
 
-def _relative_to(r: Resolver, node: ir.Operator, ops: list[Any]) -> Any:
+def _relative_to(r: Context, node: ir.Operator, ops: list[Any]) -> Any:
     """``X relative to Y``: Scenic's RelativeTo for fields, oriented points, headings and vectors."""
     x, y = ops
     if isinstance(x, Field) or isinstance(y, Field):
@@ -428,7 +427,7 @@ def _relative_to(r: Resolver, node: ir.Operator, ops: list[Any]) -> Any:
     return V.add(r.f, to_vec(r, x, _operand(node, 0)), to_vec(r, y, _operand(node, 1)))
 
 
-def _field_relative(r: Resolver, node: ir.Operator, x: Any, y: Any) -> Delayed:
+def _field_relative(r: Context, node: ir.Operator, x: Any, y: Any) -> Delayed:
     """A heading relative to a field: the field at the position of the object being built, plus the heading."""
 
     def value(part: Any, view: Any, i: int) -> Term:
@@ -439,34 +438,34 @@ def _field_relative(r: Resolver, node: ir.Operator, x: Any, y: Any) -> Delayed:
     return Delayed(lambda view: r.f.op("add", value(x, view, 0), value(y, view, 1)), "a heading relative to a field")
 
 
-def _offset_along(r: Resolver, node: ir.Operator, ops: list[Any]) -> Vec:
+def _offset_along(r: Context, node: ir.Operator, ops: list[Any]) -> Vec:
     base = to_vec(r, ops[0], _operand(node, 0))
     direction = field_at(r, ops[1], base) if isinstance(ops[1], Field) else to_heading(r, ops[1], _operand(node, 1))
     return V.offset_locally(r.f, base, direction, to_vec(r, ops[2], _operand(node, 2)))
 
 
-def _from_ego(r: Resolver, value: Any) -> Any:
+def _from_ego(r: Context, value: Any) -> Any:
     return r.scope["ego"] if value is None else value
 
 
-def _ego_required(r: Resolver, node: ir.Operator, ops: list[Any]) -> None:
+def _ego_required(r: Context, node: ir.Operator, ops: list[Any]) -> None:
     if any(o is None for o in ops) and "ego" not in r.scope:
         raise r.error("this operator refers to ego, which is not defined yet", node)
 
 
-def _relative_position(r: Resolver, node: ir.Operator, ops: list[Any]) -> Vec:
+def _relative_position(r: Context, node: ir.Operator, ops: list[Any]) -> Vec:
     _ego_required(r, node, ops)
     target = to_vec(r, ops[0], _operand(node, 0))
     return V.sub(r.f, target, to_vec(r, _from_ego(r, ops[1]), _operand(node, 1)))
 
 
-def _relative_heading(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _relative_heading(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     _ego_required(r, node, ops)
     target = to_heading(r, ops[0], _operand(node, 0))
     return r.f.op("wrap", r.f.op("sub", target, to_heading(r, _from_ego(r, ops[1]), _operand(node, 1))))
 
 
-def _apparent_heading(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _apparent_heading(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     _ego_required(r, node, ops)
     if not is_oriented(ops[0]):
         raise r.error("'apparent heading of X' needs X an oriented point or object", _operand(node, 0))
@@ -476,7 +475,7 @@ def _apparent_heading(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
     return r.f.op("wrap", r.f.op("sub", ops[0].get("heading"), direction))
 
 
-def _distance(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _distance(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     _ego_required(r, node, ops)
     a, b = ops[0], _from_ego(r, ops[1])
     if isinstance(a, Region) or isinstance(b, Region):
@@ -486,7 +485,7 @@ def _distance(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
     return V.norm(r.f, V.sub(r.f, to_vec(r, a, _operand(node, 0)), to_vec(r, b, _operand(node, 1))))
 
 
-def _distance_past(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _distance_past(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     _ego_required(r, node, ops)
     base = _from_ego(r, ops[1])
     if not is_oriented(base):
@@ -496,23 +495,21 @@ def _distance_past(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
     return V.rotate(r.f, offset, r.f.op("neg", base.get("heading"))).y
 
 
-def _angle(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _angle(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     _ego_required(r, node, ops)
     source = to_vec(r, _from_ego(r, ops[0]), _operand(node, 0))
     target = to_vec(r, _from_ego(r, ops[1]), _operand(node, 1))
     return V.heading_of(r.f, V.sub(r.f, target, source))
 
 
-def _follow(r: Resolver, node: ir.Operator, ops: list[Any]) -> Instance:
-    from .specifiers import oriented_point
-
+def _follow(r: Context, node: ir.Operator, ops: list[Any]) -> Instance:
     if not isinstance(ops[0], Field):
         raise r.error(f"expected a vector field, got {type_name(ops[0])}", _operand(node, 0))
     position = follow(r, ops[0], to_vec(r, ops[1], _operand(node, 1)), to_num(r, ops[2], _operand(node, 2)))
     return oriented_point(r, node, position, field_at(r, ops[0], position))
 
 
-def follow(r: Resolver, field: Field, start: Vec, distance: Term) -> Vec:
+def follow(r: Context, field: Field, start: Vec, distance: Term) -> Vec:
     """Scenic's ``F.followFrom(start, distance)``: forward Euler along the field (see :mod:`.geometry`)."""
     return Vec(
         r.f.op("follow", start.x, start.y, distance, value=(field, 0)),
@@ -520,7 +517,7 @@ def follow(r: Resolver, field: Field, start: Vec, distance: Term) -> Vec:
     )
 
 
-def _visible(r: Resolver, node: ir.Operator, ops: list[Any]) -> Region:
+def _visible(r: Context, node: ir.Operator, ops: list[Any]) -> Region:
     region = to_region(r, ops[0], _operand(node, 0))
     if node.name in ("visible", "not visible") and "ego" not in r.scope:
         raise r.error("'visible R' refers to ego, which is not defined yet", node)
@@ -531,12 +528,12 @@ def _visible(r: Resolver, node: ir.Operator, ops: list[Any]) -> Region:
     return Intersection((region, sector))
 
 
-def _can_see(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _can_see(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     sector = visible_region(r, ops[0], _operand(node, 0))
     return sees(r, sector, ops[1], _operand(node, 1))
 
 
-def sees(r: Resolver, sector: Sector, target: Any, node: ir.Node) -> Term:
+def sees(r: Context, sector: Sector, target: Any, node: ir.Node) -> Term:
     """Scenic 2-D visibility without occlusion: an object's box meets the sector, a point lies in it."""
     if isinstance(target, Instance) and target.is_object:
         return r.f.op("box_visible", *box_terms(target), EXACT(r), value=sector, kind="bool")
@@ -544,7 +541,7 @@ def sees(r: Resolver, sector: Sector, target: Any, node: ir.Node) -> Term:
     return r.f.op("in_region", point.x, point.y, value=sector, kind="bool")
 
 
-def _intersects(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
+def _intersects(r: Context, node: ir.Operator, ops: list[Any]) -> Term:
     a, b = ops
     if isinstance(a, Instance) and isinstance(b, Instance) and a.is_object and b.is_object:
         return r.f.op("boxes_overlap", *box_terms(a), *box_terms(b), EXACT(r), kind="bool")
@@ -556,9 +553,24 @@ def _intersects(r: Resolver, node: ir.Operator, ops: list[Any]) -> Term:
 
 
 def _complement(region: Region) -> Region:
-    from .regions import Everywhere
-
     return Difference(Everywhere(), region)
+
+
+def oriented_point(r: Context, node: ir.Node, position: Vec, heading: Term) -> Instance:
+    """An OrientedPoint value made by an operator (``follow``, ``front of``)."""
+    spec = CLASSES["OrientedPoint"]
+    point = Instance(f"OrientedPoint@{node.span.line}", spec, node.span)
+    point.defining.update(
+        position=position,
+        heading=heading,
+        parentOrientation=heading,
+        yaw=r.f.const(0),
+        visibleDistance=r.f.const(50),
+        viewAngle=r.f.const(math.tau),
+        width=r.f.const(0),
+        length=r.f.const(0),
+    )
+    return point
 
 
 _SIDES = {
@@ -573,10 +585,8 @@ _SIDES = {
 }
 
 
-def _position_of(r: Resolver, node: ir.Operator, ops: list[Any]) -> Instance:
+def _position_of(r: Context, node: ir.Operator, ops: list[Any]) -> Instance:
     """``front of O`` and friends: the oriented point at that side of the object's box."""
-    from .specifiers import oriented_point
-
     obj = ops[0]
     if not (isinstance(obj, Instance) and obj.is_object):
         raise r.error(f"'{node.name} O' needs an object, got {type_name(obj)}", _operand(node, 0))
@@ -586,7 +596,7 @@ def _position_of(r: Resolver, node: ir.Operator, ops: list[Any]) -> Instance:
     return oriented_point(r, node, position, obj.get("heading"))
 
 
-_OPERATORS: dict[str, Callable[[Resolver, ir.Operator, list[Any]], Any]] = {
+_OPERATORS: dict[str, Callable[[Context, ir.Operator, list[Any]], Any]] = {
     "deg": _deg,
     "vector": _vector,
     "field at": _field_at,
@@ -608,7 +618,7 @@ _OPERATORS: dict[str, Callable[[Resolver, ir.Operator, list[Any]], Any]] = {
     **{name: _position_of for name in _SIDES},
 }
 
-_HANDLERS: dict[type, Callable[[Resolver, Any], Any]] = {
+_HANDLERS: dict[type, Callable[[Context, Any], Any]] = {
     ir.Constant: _constant,
     ir.Name: _name,
     ir.Sequence: _sequence,

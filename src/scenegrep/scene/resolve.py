@@ -20,6 +20,7 @@ from . import expressions
 from .domain import MODELS, Default
 from .program import TRACE, Requirement, SceneProgram
 from .regions import WALKABLE, Everywhere, MapField, MapRegion, Nowhere, Union
+from .specifiers import add_collision_requirements, construct
 from .terms import Term
 from .values import Instance, Namespace
 
@@ -65,7 +66,8 @@ webots and GTA world models."""
 
 
 class Resolver:
-    """Resolves one program; see the module docstring. Use :func:`resolve`."""
+    """Resolves one program; see the module docstring. Use :func:`resolve`. It is the
+    :class:`~.context.Context` that :mod:`.expressions` and :mod:`.specifiers` evaluate in."""
 
     def __init__(
         self, program: ir.Program, visible_distance: float | None = None, free_fields: frozenset[str] = frozenset()
@@ -98,8 +100,6 @@ class Resolver:
             self.statement(statement)
         if "ego" not in self.scope:
             raise self.error("the program defines no ego object ('ego = new Car ...')", ir.NOWHERE)
-        from .specifiers import add_collision_requirements
-
         add_collision_requirements(self)
         return self.scene
 
@@ -188,8 +188,6 @@ class Resolver:
     def evaluate(self, node: ir.Node, name: str | None) -> Any:
         """The value of an expression; ``name`` names an object created by a top-level ``new``."""
         if isinstance(node, ir.New):
-            from .specifiers import construct
-
             return construct(self, node, self.instance_name(node, name))
         return expressions.evaluate(self, node)
 

@@ -20,11 +20,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ..scenic import ir
 from . import expressions as E
 from . import vectors as V
+from .context import Context
 from .domain import (
     CLASSES,
     DERIVED_PROPERTIES,
@@ -47,9 +48,6 @@ from .regions import (
 from .terms import RandomPoint, RandomVariable, Term
 from .lenient_boxes import eased
 from .values import Delayed, Instance, SelfView, Vec, observed_view, type_name
-
-if TYPE_CHECKING:
-    from .resolve import Resolver
 
 
 @dataclass(frozen=True)
@@ -79,7 +77,7 @@ class Effect:
 class Builder(SelfView):
     """Resolves the properties of one instance on demand, detecting cycles."""
 
-    def __init__(self, r: Resolver, instance: Instance, sources: dict[str, Effect | Default]):
+    def __init__(self, r: Context, instance: Instance, sources: dict[str, Effect | Default]):
         self.r = r
         self.instance = instance
         self.sources = sources
@@ -116,7 +114,7 @@ class Builder(SelfView):
         return result
 
 
-def heading_of_instance(r: Resolver, b: Builder) -> Term:
+def heading_of_instance(r: Context, b: Builder) -> Term:
     """The heading a point or object gets: its absolute facing, else parentOrientation + yaw."""
     yaw = b.value("yaw")
     if isinstance(yaw, AbsoluteHeading):
@@ -126,7 +124,7 @@ def heading_of_instance(r: Resolver, b: Builder) -> Term:
 
 
 # ---------------------------------------------------------------------------- construction
-def construct(r: Resolver, node: ir.New, name: str) -> Instance:
+def construct(r: Context, node: ir.New, name: str) -> Instance:
     """Build the instance a ``new`` creates; scene objects join the scene program."""
     spec = CLASSES.get(node.class_name)
     if spec is None:
@@ -161,7 +159,7 @@ def construct(r: Resolver, node: ir.New, name: str) -> Instance:
     return instance
 
 
-def _behaviour_call(r: Resolver, node: ir.New) -> ir.Call | None:
+def _behaviour_call(r: Context, node: ir.New) -> ir.Call | None:
     """The call of the ``with behavior`` specifier, if any (behaviours do not shape the scene)."""
     found = [s for s in node.specifiers if s.property == "behavior"]
     if not found:
@@ -176,7 +174,7 @@ def _behaviour_call(r: Resolver, node: ir.New) -> ir.Call | None:
     return value
 
 
-def _choose(r: Resolver, effects: list[Effect]) -> tuple[dict[str, Effect], list[Effect]]:
+def _choose(r: Context, effects: list[Effect]) -> tuple[dict[str, Effect], list[Effect]]:
     """The specifier setting each property (strongest priority), and the modifying specifiers."""
     chosen: dict[str, Effect] = {}
     seen_names: set[str] = set()
@@ -199,7 +197,7 @@ def _choose(r: Resolver, effects: list[Effect]) -> tuple[dict[str, Effect], list
     return chosen, modifiers
 
 
-def _check_types(r: Resolver, instance: Instance, node: ir.New) -> None:
+def _check_types(r: Context, instance: Instance, node: ir.New) -> None:
     expected = {"position": Vec, "regionContainedIn": (Region, Term)}
     for prop, kind in expected.items():
         value = instance.defining.get(prop)
@@ -208,7 +206,7 @@ def _check_types(r: Resolver, instance: Instance, node: ir.New) -> None:
 
 
 def _add_scene_object(
-    r: Resolver,
+    r: Context,
     obj: Instance,
     chosen: dict[str, Effect],
     modifiers: list[Effect],
@@ -241,7 +239,7 @@ def _add_scene_object(
     _add_implicit_requirements(r, obj, modifiers, node)
 
 
-def _add_implicit_requirements(r: Resolver, obj: Instance, modifiers: list[Effect], node: ir.New) -> None:
+def _add_implicit_requirements(r: Context, obj: Instance, modifiers: list[Effect], node: ir.New) -> None:
     """Scenic's default requirements of a scene object (``Scenario.generateDefaultRequirements``)."""
     box = E.box_terms(obj)
     container = obj.defining.get("regionContainedIn")
@@ -274,7 +272,7 @@ def _add_implicit_requirements(r: Resolver, obj: Instance, modifiers: list[Effec
 
 
 def _implicit(
-    r: Resolver, term: Term, description: str, where: ir.Node | ir.Span, container_of: str | None = None
+    r: Context, term: Term, description: str, where: ir.Node | ir.Span, container_of: str | None = None
 ) -> None:
     span = where if isinstance(where, ir.Span) else where.span
     r.scene.requirements.append(
@@ -282,7 +280,7 @@ def _implicit(
     )
 
 
-def add_collision_requirements(r: Resolver) -> None:
+def add_collision_requirements(r: Context) -> None:
     """No two scene objects' boxes intersect unless one allows collisions."""
     objects = [i for i in r.instances if i.is_object]
     for i, a in enumerate(objects):
@@ -294,25 +292,8 @@ def add_collision_requirements(r: Resolver) -> None:
                 _implicit(r, term, f"{a.name} and {b.name} do not intersect", a.span)
 
 
-def oriented_point(r: Resolver, node: ir.Node, position: Vec, heading: Term) -> Instance:
-    """An OrientedPoint value made by an operator (``follow``, ``front of``)."""
-    spec = CLASSES["OrientedPoint"]
-    point = Instance(f"OrientedPoint@{node.span.line}", spec, node.span)
-    point.defining.update(
-        position=position,
-        heading=heading,
-        parentOrientation=heading,
-        yaw=r.f.const(0),
-        visibleDistance=r.f.const(50),
-        viewAngle=r.f.const(math.tau),
-        width=r.f.const(0),
-        length=r.f.const(0),
-    )
-    return point
-
-
 # ---------------------------------------------------------------------------- specifiers
-def _effect(r: Resolver, node: ir.Specifier) -> Effect:
+def _effect(r: Context, node: ir.Specifier) -> Effect:
     operands = [None if o is None else E.evaluate(r, o) for o in node.operands]
     return _SPECIFIERS[node.name](r, node, operands)
 
@@ -321,7 +302,7 @@ def _op_node(node: ir.Specifier, i: int) -> ir.Node:
     return node.operands[i] or node
 
 
-def _with(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _with(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     prop = node.property or ""
     if prop in UNMODELLED_PROPERTIES:
         raise r.error(f"the property {prop!r} is not supported: {UNMODELLED_PROPERTIES[prop]}", node)
@@ -335,12 +316,12 @@ def _with(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect("with", {prop: 1}, lambda view: {prop: ops[0]}, node)
 
 
-def _at(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _at(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     position = E.to_vec(r, ops[0], _op_node(node, 0))
     return Effect("at", {"position": 1}, lambda view: {"position": position}, node)
 
 
-def random_point(r: Resolver, region: Region, node: ir.Node, description: str) -> Vec:
+def random_point(r: Context, region: Region, node: ir.Node, description: str) -> Vec:
     """A point drawn uniformly from ``region`` (cropped to the visible distance around the ego, if set)."""
     if r.visible_distance is not None:
         ego_x, ego_y = r.f.observed("ego", "x"), r.f.observed("ego", "y")
@@ -358,7 +339,7 @@ def _own_position(view: Any, point: Vec) -> Vec:
     return view.get("position")
 
 
-def _orientation_value(r: Resolver, region: Region, position: Vec, node: ir.Node) -> Term:
+def _orientation_value(r: Context, region: Region, position: Vec, node: ir.Node) -> Term:
     """The region's preferred orientation at ``position``; a heading free over the reals where the
     resolver takes the field as unknown and unconstrained (``r.free_fields``: ``--unknown-layers
     permissive`` on a map that does not give it)."""
@@ -374,7 +355,7 @@ def _is_oriented_region(region: Region) -> bool:
     return orientation_of(region) is not None
 
 
-def _in(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _in(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     region = E.to_region(r, ops[0], _op_node(node, 0))
     priorities = {"position": 1}
     if node.name == "contained in":
@@ -392,7 +373,7 @@ def _in(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect(node.name, priorities, compute, node)
 
 
-def _on(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _on(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     target = ops[0]
     if isinstance(target, Instance):
         raise r.error("'on <object>' places objects on 3-D surfaces; not supported in 2-D queries", node)
@@ -415,14 +396,14 @@ def _on(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect("on", priorities, compute, node, modifies=frozenset({"position"}))
 
 
-def _ego_of(r: Resolver, node: ir.Node) -> Instance:
+def _ego_of(r: Context, node: ir.Node) -> Instance:
     ego = r.scope.get("ego")
     if ego is None:
         raise r.error("this specifier refers to ego, which is not defined yet", node)
     return ego
 
 
-def _offset_by(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _offset_by(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     ego = _ego_of(r, node)
     offset = E.to_vec(r, ops[0], _op_node(node, 0))
     position = V.offset_locally(r.f, ego.get("position"), ego.get("heading"), offset)
@@ -430,7 +411,7 @@ def _offset_by(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect("offset by", {"position": 1, "parentOrientation": 3}, lambda view: values, node)
 
 
-def _offset_along(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _offset_along(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     ego = _ego_of(r, node)
     base = ego.get("position")
     direction = ops[0]
@@ -449,7 +430,7 @@ _DIRECTIONS = {
 }
 
 
-def _direction(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _direction(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     """``left of / right of / ahead of / behind X [by D]`` (veneer.directionalSpecHelper)."""
     axis, sx, sy, along_x = _DIRECTIONS[node.name]
     reference, distance = ops
@@ -488,7 +469,7 @@ def _direction(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect(node.name, {"position": 1}, absolute, node)
 
 
-def _beyond(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _beyond(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     """``beyond X by D [from Z]``: X + D rotated to face away from Z. Scenic 3.1.1 turns Z into a
     vector before asking whether it is oriented, so the parent orientation is always global (0)."""
     target = E.to_vec(r, ops[0], _op_node(node, 0))
@@ -503,7 +484,7 @@ def _beyond(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect("beyond", {"position": 1, "parentOrientation": 3}, lambda view: values, node)
 
 
-def _visible(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _visible(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     base = ops[0] if ops[0] is not None else _ego_of(r, node)
     sector = E.visible_region(r, base, _op_node(node, 0))
     if node.name == "visible":
@@ -523,7 +504,7 @@ def _visible(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect("not visible", {"position": 3, "_nonObservingEntity": 1}, hidden, node)
 
 
-def _following(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _following(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     field_value, base, distance = ops
     if not isinstance(field_value, Field):
         raise r.error(f"expected a vector field, got {type_name(field_value)}", _op_node(node, 0))
@@ -537,7 +518,7 @@ def _following(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect("following", {"position": 1, "parentOrientation": 3}, compute, node)
 
 
-def _facing(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _facing(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     heading = ops[0]
 
     def compute(view: Any) -> dict[str, Any]:
@@ -549,7 +530,7 @@ def _facing(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect("facing", {"yaw": 1}, compute, node)
 
 
-def _facing_toward(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _facing_toward(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     target = E.to_vec(r, ops[0], _op_node(node, 0))
     away = node.name == "facing away from"
 
@@ -561,7 +542,7 @@ def _facing_toward(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
     return Effect(node.name, {"yaw": 1}, compute, node)
 
 
-def _apparently_facing(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effect:
+def _apparently_facing(r: Context, node: ir.Specifier, ops: list[Any]) -> Effect:
     heading = E.to_heading(r, ops[0], _op_node(node, 0))
     base = E.to_vec(r, ops[1] if ops[1] is not None else _ego_of(r, node), _op_node(node, 1))
 
@@ -572,7 +553,7 @@ def _apparently_facing(r: Resolver, node: ir.Specifier, ops: list[Any]) -> Effec
     return Effect("apparently facing", {"yaw": 1}, compute, node)
 
 
-_SPECIFIERS: dict[str, Callable[[Resolver, ir.Specifier, list[Any]], Effect]] = {
+_SPECIFIERS: dict[str, Callable[[Context, ir.Specifier, list[Any]], Effect]] = {
     "with": _with,
     "at": _at,
     "in": _in,

@@ -15,19 +15,17 @@ label object, the features that fail and the tolerances that would admit them.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..scene.misses import nearest_miss, spread
+from ..scene.program import SceneProgram
 from ..scene.query import SceneResult
 
-from .hfsm import CAN_FALSE, CAN_TRUE, Config
+from .hfsm import CAN_FALSE, CAN_TRUE, Config, Hfsm
 from .search import Assignment, Outcome, Search
+from .translate import Guard
 from .vocabulary import STATIONARY
-
-if TYPE_CHECKING:
-    from .query import ScenarioQuery
 
 _GUARD_TEXT = {CAN_TRUE: "true", CAN_FALSE: "false", CAN_TRUE | CAN_FALSE: "true or false"}
 
@@ -37,14 +35,19 @@ class Explainer:
 
     def __init__(
         self,
-        query: ScenarioQuery,
+        hfsms: dict[str, Hfsm],
+        guards: list[Guard],
+        program: SceneProgram,
         search: Search,
         outcome: Outcome,
         scene_at: Callable[[dict[str, str], np.ndarray], SceneResult],
     ):
-        """``scene_at(correspondence, starts)`` matches the initial scene at some window starts
-        with a (partial) correspondence, program object -> label object id."""
-        self.query = query
+        """The query's HFSMs (by program object), guards and scene program; the search and its
+        outcome. ``scene_at(correspondence, starts)`` matches the initial scene at some window
+        starts with a (partial) correspondence, program object -> label object id."""
+        self.hfsms = hfsms
+        self.guards = guards
+        self.program = program
         self.scene_at = scene_at
         self.search = search
         self.outcome = outcome
@@ -88,11 +91,11 @@ class Explainer:
             f"window {self.frame(start)} to {self.frame(start + m - 1)} ({m} frames); "
             + ", ".join(f"{name} = {label}" for name, label in correspondence.items())
         ]
-        runs = {obj: self.run(obj, assignment, start, m) for obj in self.query.hfsms}
+        runs = {obj: self.run(obj, assignment, start, m) for obj in self.hfsms}
         for step in range(m):
             position = start + step
             lines.append(f"step {step}, {self.frame(position)}:")
-            for obj, hfsm in self.query.hfsms.items():
+            for obj, hfsm in self.hfsms.items():
                 symbol, outputs, configs = runs[obj][step]
                 guards = self._guard_values(obj, symbol)
                 kept = sorted({hfsm.path(c) for c in configs})
@@ -105,9 +108,7 @@ class Explainer:
     def _guard_values(self, obj: str, symbol: int) -> str:
         automaton = self.search.automata[obj]
         inputs = automaton.inputs(symbol)
-        parts = [
-            f"{self.query.guards[g].text} is {_GUARD_TEXT[inputs.guards[g]]}" for g in self.query.hfsms[obj].guards
-        ]
+        parts = [f"{self.guards[g].text} is {_GUARD_TEXT[inputs.guards[g]]}" for g in self.hfsms[obj].guards]
         return "; " + "; ".join(parts) if parts else ""
 
     # ---------------------------------------------------------------- non-matches
@@ -118,7 +119,7 @@ class Explainer:
             return f"the trace has {self.trace.n_frames} frames, fewer than the window of {m}"
         for obj, cands in out.candidates.items():
             if not cands:
-                program_object = self.query.scene.program.object(obj)
+                program_object = self.program.object(obj)
                 return (
                     f"no label object that can be {obj} ({program_object.class_name}) is observed for "
                     f"{m} consecutive frames"

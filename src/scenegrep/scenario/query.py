@@ -185,7 +185,9 @@ class ScenarioQuery:
             ScenarioMatch({name: str(ids[row]) for name, row in assignment.items()}, starts)
             for assignment, starts in outcome.matches
         ]
-        return ScenarioResult(trace, m, matches, Explainer(self, search, outcome, scene_at))
+        return ScenarioResult(
+            trace, m, matches, Explainer(self.hfsms, self.guards, self.scene.program, search, outcome, scene_at)
+        )
 
     def initial_scene(
         self,

@@ -41,13 +41,13 @@ import numpy as np
 
 from ..errors import UserError, at
 from ..model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
+from ..writers.strem_json import STREM_VERSION
 from . import _strem
 from .common import STDIN, display_name, malformed, reading
 from .json_locate import line_column
 from .json_stream import DocumentSplitter
 
 FORMAT = "strem-json"
-STREM_VERSION = "0.2.0"
 
 
 def _trace(columns: dict, name: str, source: TraceSource) -> LabelTrace:

@@ -7,7 +7,9 @@ from typing import Any
 import numpy as np
 
 from ..model import LabelTrace
-from ..readers.strem_json import STREM_VERSION
+
+STREM_VERSION = "0.2.0"
+"""The STREM JSON version written (and the one :mod:`scenegrep.readers.strem_json` reads)."""
 
 
 def _box(trace: LabelTrace, k: int) -> dict[str, Any]:

@@ -30,7 +30,6 @@ from .. import readers
 from ..errors import UserError, at, failure_text
 from ..model import LabelTrace, RoadMap
 from ..model.layers import UnknownLayers
-from ..readers.trace_folder import SKIPPED
 from .catalog import Catalog
 from .execute import run_all
 from .labelling import COLUMN, labelled, recorded_choice
@@ -136,7 +135,7 @@ def _file_format(path: Path, explicit: bool) -> str | None:
             raise UserError(f"a {readers.FORMATS[name].description} holds no label trace", at(path))
         return name
     name = readers.sniff_file(path)
-    return name if name is not None and name not in SKIPPED and readers.FORMATS[name].traces else None
+    return name if name is not None and name not in readers.SKIPPED and readers.FORMATS[name].traces else None
 
 
 def directory_format(path: Path) -> str | None:

@@ -10,6 +10,12 @@ offers some of:
 
 :func:`detect_format` names the format of a path; :func:`read_traces`,
 :func:`read_trace` and :func:`read_map` dispatch to the module.
+
+A folder of trace files (a dataset written by ``scenegrep synth`` or ``scenegrep label``, say) is
+read here, each file by its own format: every file directly in the folder whose format holds label
+traces, in name order; other files (a manifest, a README, maps) are skipped, and so are JSON files
+that are not scenegrep traces (STREM streams are recognised by weak signs only: give them by
+name). Sub-folders are not entered.
 """
 
 from __future__ import annotations
@@ -34,10 +40,11 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Format:
-    """A supported input format: its name, module, and what it holds."""
+    """A supported input format: its name, module (None: read by this package, a folder of trace
+    files), and what it holds."""
 
     name: str
-    module: str
+    module: str | None
     description: str
     traces: bool
     map: bool
@@ -77,11 +84,12 @@ FORMATS: dict[str, Format] = {
             True,
             False,
         ),
-        Format(
-            "trace-folder", "trace_folder", "folder of trace files (each read in name order)", True, False, many=True
-        ),
+        Format("trace-folder", None, "folder of trace files (each read in name order)", True, False, many=True),
     )
 }
+
+SKIPPED = frozenset({"strem-json"})
+"""Formats not collected from a folder of trace files (see the module docstring)."""
 
 
 def module(format_name: str) -> ModuleType:
@@ -137,7 +145,7 @@ def detect_format(path: str | Path) -> str:
             return "av2-forecasting"
         if (path / "metadata.yaml").is_file() and (any(path.glob("*.mcap")) or any(path.glob("*.db3"))):
             return "ros-bag"
-        if module("trace-folder").trace_files(path):
+        if trace_files(path):
             return "trace-folder"
         raise UserError("a directory that is neither an Argoverse 2 log or scenario nor holds trace files", at(path))
     file = regular_file(path, "a trace or map file, or a recording directory")
@@ -145,6 +153,16 @@ def detect_format(path: str | Path) -> str:
         found = sniff_file(file)
     if found is None:
         raise UserError(f"unrecognised input format; supported: {', '.join(FORMATS)}", at(path))
+    return found
+
+
+def trace_files(path: str | Path) -> list[Path]:
+    """The files directly in a folder that hold label traces, in name order."""
+    found = []
+    for child in sorted(Path(path).iterdir()):
+        name = sniff_file(child) if child.is_file() else None
+        if name is not None and name not in SKIPPED and FORMATS[name].traces:
+            found.append(child)
     return found
 
 
@@ -163,6 +181,13 @@ def read_traces(path: str | Path, format_name: str | None = None) -> Iterator[La
     """Every trace in a file or recording directory; a malformed input is a :class:`UserError`
     (a path that is neither a directory, nor ``-`` for stdin, must be a regular file)."""
     name = _checked(path, format_name, "traces")
+    if name == "trace-folder":
+        files = trace_files(path)
+        if not files:
+            raise UserError("a folder without trace files", at(path))
+        for child in files:
+            yield from read_traces(child)
+        return
     if str(path) != "-" and not Path(path).is_dir():
         regular_file(path, f"a trace file ({name})")
     reader = module(name)

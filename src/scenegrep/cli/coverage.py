@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from .dataset_run import RowPrinter, results_of
-from .main import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
+from .exit_codes import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
 from .options import (
     add_dataset_arguments,
     add_map_argument,

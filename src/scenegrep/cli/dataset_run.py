@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from .inputs import is_one_input
-from .main import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
+from .exit_codes import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
 from .options import reject_dataset_only, report_unknown_layers, run_options_of
 
 

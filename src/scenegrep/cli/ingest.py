@@ -13,7 +13,7 @@ import argparse
 import sys
 from typing import Any
 
-from .main import EXIT_SOME_FAILED
+from .exit_codes import EXIT_SOME_FAILED
 from .options import add_jobs_argument, add_unknown_layers_argument, report_unknown_layers
 
 

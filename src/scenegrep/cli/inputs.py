@@ -14,7 +14,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from .main import EXIT_SOME_FAILED
+from .exit_codes import EXIT_SOME_FAILED
 
 
 def each_input(paths: list[str], work: Callable[[str], None]) -> int:

@@ -21,6 +21,7 @@ from collections.abc import Sequence
 from .. import __version__  # noqa: E402
 from ..errors import UserError  # noqa: E402
 from ..terminal import EscapingStream, OutputError  # noqa: E402
+from .exit_codes import EXIT_INTERRUPTED, EXIT_USER_ERROR  # noqa: E402
 from .parsing import PROGRAM, CommandParser, parse_command_line  # noqa: E402
 
 COMMANDS = (
@@ -39,11 +40,6 @@ COMMANDS = (
     "synth",
 )
 """Command modules of this package, each with ``add_parser(subparsers)`` and ``run(args) -> int``."""
-
-EXIT_NO_MATCH = 1
-EXIT_USER_ERROR = 2
-EXIT_SOME_FAILED = 3
-EXIT_INTERRUPTED = 130
 
 
 def build_parser() -> argparse.ArgumentParser:

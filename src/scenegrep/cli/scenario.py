@@ -20,7 +20,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from .dataset_run import RowPrinter, run_query_command
-from .main import EXIT_NO_MATCH
+from .exit_codes import EXIT_NO_MATCH
 from .options import (
     add_bag_arguments,
     add_dataset_arguments,

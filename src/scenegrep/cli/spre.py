@@ -19,7 +19,7 @@ from typing import Any
 
 from ..json_lines import line
 from .dataset_run import run_query_command
-from .main import EXIT_NO_MATCH
+from .exit_codes import EXIT_NO_MATCH
 from .options import (
     add_bag_arguments,
     add_dataset_arguments,

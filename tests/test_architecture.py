@@ -28,7 +28,7 @@ SRC = Path(__file__).resolve().parents[1] / "src"
 PACKAGE = "scenegrep"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("errors", "cache", "lazy"),  # foundations: they import nothing of scenegrep
+    ("errors", "cache", "lazy", "progress"),  # foundations: they import nothing of scenegrep
     ("model", "terminal"),  # the data model (label traces, road maps); text safe for terminals
     ("writers",),  # the model to files
     ("readers",),  # files to the model (converted maps are cached through the writers)
@@ -268,8 +268,12 @@ def test_the_walker_sees_every_kind_of_import(tmp_path):
             "def f():\n    from . import b\n    import pkg.sub.c\n"
         ),
         "pkg/b.py": "from .sub.c import name\nfrom . import thing\n",
-        "pkg/sub/__init__.py": "import importlib\ndef load(n):\n    return importlib.import_module(f'{__name__}.{n}')\n",
-        "pkg/sub/c.py": "from ..sub import deep\nfrom scenegrep.lazy import lazy_import\nd = lazy_import('pkg.sub._ext')\n",
+        "pkg/sub/__init__.py": (
+            "import importlib\ndef load(n):\n    return importlib.import_module(f'{__package__}.{n}')\n"
+        ),
+        "pkg/sub/c.py": (
+            "from ..sub import deep\nfrom scenegrep.lazy import lazy_import\nx = lazy_import('pkg.sub._ext')\n"
+        ),
         "pkg/sub/deep.py": "",
         "pkg/sub/_ext.c": "",
     }

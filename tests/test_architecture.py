@@ -12,7 +12,8 @@ of the caller's package, so it counts as importing all of them. Importing ``a.b.
 
 :data:`LAYERS` orders the package's top-level units (subpackages and modules), lowest first. A
 unit may import units of lower layers only; units that share a layer are independent of each
-other.
+other. :data:`SCENE_LAYERS` orders the scene package's modules likewise (the map in its
+``__init__``), but a module may import others of its own group there.
 """
 
 from __future__ import annotations
@@ -41,6 +42,17 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("__main__",),  # python -m scenegrep
 )
 """Top-level units of ``scenegrep``, lowest layer first (README, "Development")."""
+
+SCENE_LAYERS: tuple[tuple[str, ...], ...] = (
+    ("terms", "regions", "values", "vectors", "domain", "program"),  # the term language
+    ("geometry", "shapes", "unknown", "follow", "follow_pieces", "follow_regions", "follow_inverse"),  # map geometry
+    ("context", "expressions", "specifiers", "lenient_boxes", "resolve", "needs"),  # syntax, specifier semantics
+    ("dependencies", "randoms", "evaluate"),  # analysis and evaluation
+    ("tolerance", "decide", "solvers"),  # the decision procedures
+    ("match", "query", "explain", "projection", "misses", "profiles"),  # the match driver
+    ("",),  # scene/__init__: the API
+)
+"""Modules (and the ``solvers`` subpackage) of ``scenegrep.scene``, lowest group first (its ``__init__``)."""
 
 Graph = Mapping[str, Iterable[str]]
 
@@ -184,21 +196,31 @@ def _circle_in(graph: Graph, component: set[str]) -> list[str]:
     raise AssertionError(f"no circle through {first}")  # a strongly connected component has one
 
 
-def unit_of(module: str, package: str = PACKAGE) -> str:
-    """The top-level unit of a module: ``scenegrep.scene.solvers.walk`` -> ``scene``; the root
-    package itself -> ``""``."""
-    return module.split(".")[1] if "." in module else "" if module == package else module
+def unit_of(module: str, package: str = PACKAGE) -> str | None:
+    """The top-level unit of a module of ``package``: ``scenegrep.scene.solvers.walk`` ->
+    ``scene`` (in ``scenegrep.scene``: ``solvers``); the package itself -> ``""``; None outside it."""
+    if module == package:
+        return ""
+    return module[len(package) + 1 :].split(".")[0] if module.startswith(f"{package}.") else None
 
 
-def layer_violations(graph: Graph, layers: tuple[tuple[str, ...], ...] = LAYERS) -> list[str]:
-    """Every import of a unit from a unit of the same or a higher layer, and every unit missing
-    from the layers, as messages."""
+def layer_violations(
+    graph: Graph, layers: tuple[tuple[str, ...], ...] = LAYERS, package: str = PACKAGE, peers: bool = False
+) -> list[str]:
+    """Every import between the units of ``package`` (:func:`unit_of`) from a unit of a higher
+    layer, or of the same layer unless ``peers`` allows that, and every unit missing from the
+    layers, as messages. Imports of modules outside ``package`` are not looked at."""
     rank = {unit: level for level, units in enumerate(layers) for unit in units}
-    problems = sorted({f"{unit_of(m)!r} has no layer in LAYERS" for m in graph if unit_of(m) not in rank})
+    units = {m: unit_of(m, package) for m in graph}
+    problems = sorted(
+        {f"{u!r} has no layer in {package}'s layers" for u in units.values() if u not in rank | {None: 0}}
+    )
     for module, targets in sorted(graph.items()):
         for target in sorted(targets):
-            a, b = unit_of(module), unit_of(target)
-            if a != b and a in rank and b in rank and rank[b] >= rank[a]:
+            a, b = units[module], unit_of(target, package)
+            if a is None or b is None or a == b or a not in rank or b not in rank:
+                continue
+            if rank[b] > rank[a] or (rank[b] == rank[a] and not peers):
                 how = "in the same layer as" if rank[b] == rank[a] else "in a higher layer than"
                 problems.append(f"{module} imports {target}: {b!r} is {how} {a!r}")
     return problems
@@ -225,9 +247,15 @@ def test_imports_point_down_the_layers(graph):
     assert not problems, "\n".join(problems)
 
 
-def test_every_layer_names_real_units(graph):
-    units = {unit_of(m) for m in graph}
-    listed = [u for layer in LAYERS for u in layer]
+def test_scene_modules_import_their_own_group_or_lower_ones(graph):
+    problems = layer_violations(graph, SCENE_LAYERS, f"{PACKAGE}.scene", peers=True)
+    assert not problems, "\n".join(problems)
+
+
+@pytest.mark.parametrize(("layers", "package"), [(LAYERS, PACKAGE), (SCENE_LAYERS, f"{PACKAGE}.scene")])
+def test_every_layer_names_real_units(graph, layers, package):
+    units = {unit_of(m, package) for m in graph} - {None}
+    listed = [u for layer in layers for u in layer]
     assert len(listed) == len(set(listed))
     assert set(listed) == units
 
@@ -248,7 +276,7 @@ def test_the_checks_fail_on_a_circle_and_on_an_upward_import():
         ["scenegrep.dataset", "scenegrep.scene.a", "scenegrep.scene.b", "scenegrep.scene.c", "scenegrep.dataset"]
     ]
     assert layer_violations(fake) == [
-        "'nowhere' has no layer in LAYERS",
+        "'nowhere' has no layer in scenegrep's layers",
         "scenegrep.scene.c imports scenegrep.dataset: 'dataset' is in a higher layer than 'scene'",
         "scenegrep.spre imports scenegrep.label: 'label' is in the same layer as 'spre'",
     ]
@@ -257,6 +285,24 @@ def test_the_checks_fail_on_a_circle_and_on_an_upward_import():
     del fake["scenegrep.nowhere"]
     assert cycles(fake) == []
     assert layer_violations(fake) == []
+
+
+def test_the_check_within_a_package_lets_a_group_import_itself_only_when_asked():
+    inner = {
+        "scenegrep.scene.a": {"scenegrep.scene.b"},
+        "scenegrep.scene.b": {"scenegrep.scene.c", "scenegrep.model"},  # model: outside the package
+        "scenegrep.scene.c": set(),
+    }
+    upward = "scenegrep.scene.b imports scenegrep.scene.c: 'c' is in a higher layer than 'b'"
+    layers = (("a", "b"), ("c",))
+    assert layer_violations(inner, layers, "scenegrep.scene", peers=True) == [upward]
+    assert layer_violations(inner, layers, "scenegrep.scene") == [
+        "scenegrep.scene.a imports scenegrep.scene.b: 'b' is in the same layer as 'a'",
+        upward,
+    ]
+    assert layer_violations(inner, (("a",), ("c",)), "scenegrep.scene", peers=True) == [
+        "'b' has no layer in scenegrep.scene's layers"
+    ]
 
 
 def test_the_walker_sees_every_kind_of_import(tmp_path):

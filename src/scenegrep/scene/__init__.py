@@ -4,9 +4,9 @@ Pipeline: Scenic source -> IR (:mod:`scenegrep.scenic`) -> feature terms (:mod:`
 dependency groups (:mod:`.dependencies`) -> Algorithm 1 over all frames (:mod:`.match`), each
 group decided by closed forms (:mod:`.decide`) or the solvers (:mod:`.solvers`).
 
-Map of the package, lowest layer first; a module imports only from its own layer or lower ones,
-and the imports have no circles (``tests/test_architecture.py``). *Term language*: :mod:`.terms`
-(the expression DAG of real-valued terms and random variables), :mod:`.regions` (regions and
+Map of the package, lowest group first: a module imports only from its own group or lower ones,
+without circles (``SCENE_LAYERS`` in ``tests/test_architecture.py``). *Term language*:
+:mod:`.terms` (the expression DAG of real-valued terms and random variables), :mod:`.regions` (regions and
 fields over terms), :mod:`.values` and :mod:`.vectors` (what resolution computes: instances,
 vectors), :mod:`.domain` (Scenic's classes and defaults), :mod:`.program` (the resolved program:
 objects' feature terms, requirements). *Map geometry*: :mod:`.geometry` (regions and fields on a

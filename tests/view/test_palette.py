@@ -4,6 +4,7 @@ channel in the pictures, a channel switch in the page)."""
 from __future__ import annotations
 
 import io
+import re
 
 import numpy as np
 import pytest
@@ -176,3 +177,10 @@ def test_the_page_names_its_channel_switches_channels_and_uses_the_same_colours(
     assert shown == as_css
     assert not browser.find_element(By.ID, "channel-choice").is_displayed()
     assert browser.get_log("browser") == []
+
+
+def test_the_trace_renderers_have_no_colours_of_their_own():
+    """Every colour of the page's script and of the pictures is :mod:`scenegrep.view.style`'s."""
+    view = REPO / "src" / "scenegrep" / "view"
+    for name in ("assets/view.js", "plot.py", "payload.py", "charts.py"):
+        assert re.findall(r"#[0-9a-fA-F]{6}\b", (view / name).read_text()) == [], name

@@ -7,14 +7,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-BAR_COLOUR = "#4c78a8"
+from .style import CHART_COLOURS, GAP_COLOUR
+
+BAR_COLOUR = CHART_COLOURS[0]
 
 
 def bar_chart(
     labels: Sequence[str], series: Sequence[Sequence[float]], names: Sequence[str], title: str, chart_id: str
 ) -> str:
     """Horizontal bars, one group per label and one bar per series (each with its legend name)."""
-    colours = ("#4c78a8", "#f58518", "#54a24b", "#e45756")
+    colours = CHART_COLOURS
     row, bar, left, width = 22, 16 / max(len(series), 1), 190, 520
     top = 34 + 18 * (len(series) > 1)
     height = top + row * len(labels) + 10
@@ -80,9 +82,6 @@ def _short(label: str, most: int = 28) -> str:
 
 def _number(value: float) -> str:
     return f"{value:g}" if float(value) != int(value) else str(int(value))
-
-
-GAP_COLOUR = "#e45756"
 
 
 def bin_chart(labels: Sequence[str], counts: Sequence[int], links: Sequence[str], title: str, chart_id: str) -> str:

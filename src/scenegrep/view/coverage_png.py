@@ -1,7 +1,7 @@
 """The coverage plots as one PNG (``scenegrep coverage --png FILE``), drawn with matplotlib.
 
 The picture holds what the coverage page (:mod:`.coverage_page`) charts, in its colours
-(:data:`.charts.BAR_COLOUR`, :data:`.charts.GAP_COLOUR`): per axis (variable) a panel of bars,
+(:data:`.charts.BAR_COLOUR`, :data:`.style.GAP_COLOUR`): per axis (variable) a panel of bars,
 the matches covering each bin (bar height = count), and a red stripe under every gap (a bin no
 match covers); per pair of axes a heat map of the joint counts (empty cells white). The panel
 titles give the covered bins, the ambiguous matches and those without a value, so a reader of
@@ -18,10 +18,8 @@ import numpy as np
 
 from ..dataset.coverage import AMBIGUOUS, NO_VALUE, Coverage
 from ..writers.atomic import atomic_path
-from .charts import BAR_COLOUR, GAP_COLOUR
-
-UNKNOWN_COLOUR = "#bbbbbb"
-"""The stripe under an uncovered bin when part of the data is unknown."""
+from .charts import BAR_COLOUR
+from .style import GAP_COLOUR, UNKNOWN_COLOUR
 
 PANEL_WIDTH = 6.4
 """Width (inches) of a panel; the picture is one panel wide, at 100 dpi."""

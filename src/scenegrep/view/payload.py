@@ -17,7 +17,7 @@ import shapely
 
 from ..model import LabelTrace, RoadMap
 from .data import TraceView, image_channels
-from .style import MARKED_COLOUR, behaviour_colours, category_colours, class_colours, program_colours
+from .style import MARKED_COLOUR, SCENE_COLOURS, behaviour_colours, category_colours, class_colours, program_colours
 
 DIGITS = 2
 """Decimals kept for metres, pixels and radians."""
@@ -46,6 +46,7 @@ def payload(view: TraceView) -> dict[str, Any]:
         ],
         "program_colours": program_colours(names),
         "marked_colour": MARKED_COLOUR,
+        "scene_colours": {name: list(pair) for name, pair in SCENE_COLOURS.items()},
         "note": view.note,
         "query": None if view.query is None else {"kind": view.query.kind, "text": view.query.text},
     }

@@ -19,7 +19,14 @@ import numpy as np
 from ..errors import UserError
 from ..model.geometry import box_corners
 from .data import MatchView, TraceView, image_channels
-from .style import MARKED_COLOUR, behaviour_colours, category_colours, class_colours, program_colours
+from .style import (
+    MARKED_COLOUR,
+    SCENE_COLOURS,
+    behaviour_colours,
+    category_colours,
+    class_colours,
+    program_colours,
+)
 
 MIN_SIZE = 0.5
 """Boxes are drawn at least this long and wide (metres), so that points and unknown sizes show."""
@@ -149,7 +156,7 @@ class Figure:
         view = self.view
         self.collections, self.paths = [], []
         for k, (ax, channel) in enumerate(zip(self.axes, self.boxes.panels)):
-            ax.set_facecolor("#eef0f2")
+            ax.set_facecolor(SCENE_COLOURS["background"][0])
             if view.image_space:
                 width, height = _image_size(view, channel)
                 ax.set_aspect("equal", adjustable="box")
@@ -206,6 +213,7 @@ class Figure:
         ax, view = self.timeline, self.view
         n = view.trace.n_frames
         ax.set_xlim(0, n)
+        ax.set_facecolor(SCENE_COLOURS["timeline"][0])
         ax.set_yticks([])
         ax.set_xlabel("frame position")
         if self.names and view.trace.behaviours is not None and not view.image_space:
@@ -213,14 +221,15 @@ class Figure:
         else:
             counts = np.diff(self.offsets)
             marked = np.bincount(self.boxes.frame[self.boxes.marked], minlength=n)
-            ax.bar(np.arange(n), counts, width=1.0, align="edge", color="#c9ced6", label="objects")
+            ax.bar(np.arange(n), counts, width=1.0, align="edge", color=SCENE_COLOURS["count"][0], label="objects")
             if marked.any():
                 ax.bar(np.arange(n), marked, width=1.0, align="edge", color=MARKED_COLOUR, label="query's classes")
             ax.legend(loc="upper right", fontsize=7)
         if self.match is not None:
-            ax.axvspan(self.match.first, self.match.last + 1, color="#e63946", alpha=0.2, zorder=3)
+            fill, edge_colour = SCENE_COLOURS["window"]
+            ax.axvspan(self.match.first, self.match.last + 1, color=fill, alpha=0.2, zorder=3)
             for edge in (self.match.first, self.match.last + 1):
-                ax.axvline(edge, color="#e63946", linewidth=2, zorder=3)
+                ax.axvline(edge, color=edge_colour, linewidth=2, zorder=3)
         self.cursor = ax.axvline(0, color="#111", linewidth=1.5)
 
     def show_frame(self, frame: int) -> None:
@@ -334,7 +343,8 @@ def _image_size(view: TraceView, channel: str) -> tuple[float, float]:
 def _rectangle(width: float, height: float):
     from matplotlib.patches import Rectangle
 
-    return Rectangle((0, 0), width, height, facecolor="#20242a", edgecolor="#888", zorder=0)
+    face, edge = SCENE_COLOURS["image"]
+    return Rectangle((0, 0), width, height, facecolor=face, edgecolor=edge, zorder=0)
 
 
 def _draw_map(ax, view: TraceView) -> None:
@@ -346,9 +356,9 @@ def _draw_map(ax, view: TraceView) -> None:
     if road_map is None:
         return
     layers = (
-        ([lane.polygon for lane in road_map.lanes], "#dfe3e8", "#c3c8cf"),
-        ([area.polygon for area in road_map.intersections], "#b4bcc8", "none"),
-        ([area.polygon for area in road_map.crosswalks], "#ffffff", "#b0b6bf"),
+        ([lane.polygon for lane in road_map.lanes], *SCENE_COLOURS["lane"]),
+        ([area.polygon for area in road_map.intersections], *SCENE_COLOURS["intersection"]),
+        ([area.polygon for area in road_map.crosswalks], *SCENE_COLOURS["crosswalk"]),
     )
     for polygons, face, edge in layers:
         found = rings(polygons)

@@ -1,9 +1,11 @@
-"""The one palette of every view (the HTML page, the PNG and the GIF draw from it alone).
+"""The one palette of every view: the trace views (HTML page, PNG, GIF) and the charts of the
+report and coverage pages (SVG, PNG) draw their colours from here alone.
 
 Objects and image boxes take the colour of their canonical kind (an image box without an
 object, its class's kind), corresponded objects the colour of their program name, behaviour
-label sets a colour per set; the HTML page receives these colours in its data and has no
-palette of its own.
+label sets a colour per set; the map, the image area and the time line have fixed colours
+(:data:`SCENE_COLOURS`). The HTML page receives all of these in its data and has no palette
+of its own (its style sheet only lays the page out).
 """
 
 from __future__ import annotations
@@ -50,6 +52,30 @@ BEHAVIOUR_COLOURS = (
 
 NO_BEHAVIOUR_COLOUR = "#dcdde1"
 """Colour of frames where an object has no behaviour label (the empty set)."""
+
+
+SCENE_COLOURS = {
+    "background": ("#eef0f2", "none"),
+    "timeline": ("#f0f1f3", "none"),
+    "lane": ("#dfe3e8", "#c3c8cf"),
+    "intersection": ("#b4bcc8", "none"),
+    "crosswalk": ("#ffffff", "#b0b6bf"),
+    "image": ("#20242a", "#888888"),
+    "count": ("#c9ced6", "none"),
+    "window": ("#e63946", "#e63946"),
+}
+"""(fill, edge) of the scene's and the time line's backgrounds, of the map's lanes,
+intersections and crosswalks, of a camera image's area, of the time line's objects-per-frame
+bars and of its match window."""
+
+CHART_COLOURS = ("#4c78a8", "#f58518", "#54a24b", "#e45756")
+"""Colours of a chart's series, in order (the first is the colour of a chart of one series)."""
+
+GAP_COLOUR = "#e45756"
+"""A coverage chart's bins that no data covers."""
+
+UNKNOWN_COLOUR = "#bbbbbb"
+"""A coverage chart's bins whose coverage is unknown (failed traces, an interrupted run)."""
 
 
 def class_colours() -> dict[str, str]:

@@ -97,6 +97,8 @@
   }
 
   // ---------------------------------------------------------------- drawing
+  const scene = data.scene_colours; // [fill, edge] of the backgrounds, map layers, image area, time line (style.py)
+  function colour(c) { return c === "none" ? null : c; }
   function polygon(points, fill, stroke, width) {
     ctx.beginPath();
     points.forEach((p, k) => { const [sx, sy] = toScreen(p); if (k) ctx.lineTo(sx, sy); else ctx.moveTo(sx, sy); });
@@ -106,13 +108,16 @@
   }
   function drawMap() {
     if (!data.map) return;
-    for (const ring of data.map.lanes) polygon(ring, "#dfe3e8", "#c3c8cf", 1);
-    for (const ring of data.map.intersections) polygon(ring, "rgba(160, 170, 185, 0.35)", null);
-    for (const ring of data.map.crosswalks) polygon(ring, "rgba(255, 255, 255, 0.85)", "#b0b6bf", 1);
+    ctx.globalAlpha = 0.9; // as the pictures
+    for (const layer of ["lane", "intersection", "crosswalk"]) {
+      const [fill, edge] = scene[layer].map(colour);
+      for (const ring of data.map[`${layer}s`]) polygon(ring, fill, edge, 1);
+    }
+    ctx.globalAlpha = 1;
   }
   function drawImageFrame() {
     const [w, h] = rows.image_size;
-    polygon([[0, 0], [w || 1600, 0], [w || 1600, h || 900], [0, h || 900]], "#20242a", "#888", 1);
+    polygon([[0, 0], [w || 1600, 0], [w || 1600, h || 900], [0, h || 900]], ...scene.image.map(colour), 1);
   }
   function drawPaths(hl) {
     const m = currentMatch();
@@ -165,7 +170,7 @@
     }
   }
   function draw() {
-    ctx.clearRect(0, 0, canvas.width, canvas.height);
+    ctx.fillStyle = scene.background[0]; ctx.fillRect(0, 0, canvas.width, canvas.height);
     const hl = highlights();
     if (data.space === "image") drawImageFrame(); else drawMap();
     drawPaths(hl);
@@ -205,20 +210,20 @@
       let marked = 0;
       for (let r = rows.offsets[f]; r < rows.offsets[f + 1]; r++) if (rows.marked.length && rows.marked[r]) marked++;
       const all = rows.offsets[f + 1] - rows.offsets[f], h = labelCanvas.height;
-      lctx.fillStyle = "#c9ced6"; lctx.fillRect(f * step, h - (h * all) / most, Math.ceil(step), (h * all) / most);
+      lctx.fillStyle = scene.count[0]; lctx.fillRect(f * step, h - (h * all) / most, Math.ceil(step), (h * all) / most);
       lctx.fillStyle = data.marked_colour; lctx.fillRect(f * step, h - (h * marked) / most, Math.ceil(step), (h * marked) / most);
     }
     $("label-legend").innerHTML = rows.marked.length
-      ? '<span><i style="background:#c9ced6"></i>objects per frame</span>' +
+      ? `<span><i style="background:${scene.count[0]}"></i>objects per frame</span>` +
         `<span><i style="background:${data.marked_colour}"></i>of the classes the query names</span>`
-      : '<span><i style="background:#c9ced6"></i>objects per frame</span>';
+      : `<span><i style="background:${scene.count[0]}"></i>objects per frame</span>`;
   }
   function drawTimeline() {
     const rect = labelCanvas.getBoundingClientRect();
     labelCanvas.width = Math.max(rect.width, 100);
     labelCanvas.height = Math.max(rect.height, 20);
     lctx.clearRect(0, 0, labelCanvas.width, labelCanvas.height);
-    lctx.fillStyle = "#f0f1f3"; lctx.fillRect(0, 0, labelCanvas.width, labelCanvas.height);
+    lctx.fillStyle = scene.timeline[0]; lctx.fillRect(0, 0, labelCanvas.width, labelCanvas.height);
     const hl = [...highlights()];
     const step = labelCanvas.width / nFrames;
     // label rows of the corresponded objects where the trace has behaviour labels, as the pictures

@@ -5,7 +5,9 @@ throughput (``--read N``).
 ``--objects`` objects each (every field written, covariances included: about 1.1 kB per object;
 boxes in ``base_link``), one ``/tf`` message per frame, zstd chunks, is read by the ``ros-bag``
 reader into one trace; messages per second (TrackedObjects messages over the whole read), and
-the MCAP stream alone (records read and decompressed, nothing decoded) for comparison.
+the MCAP stream alone (records read and decompressed, nothing decoded) for comparison, each the
+median of ``--runs`` runs (alternated, so both see the same load); the ratio of the two, the CPU
+time per message (``time.process_time``) and the load average, since the machine may be shared.
 
 **Online latency.** A writer thread appends an MCAP file frame by frame at ``--rate`` frames per
 second (unchunked, as a live recorder writes) while ``scenegrep spre --follow FILE PATTERN`` runs in
@@ -30,7 +32,7 @@ follower's first decode and query compile; the maximum over all frames is report
 count must equal the lines' (FAILED otherwise).
 
     python benchmarks/bench_bag.py [--source strem|ros] [--frames 300] [--rate 30] [--boxes 20]
-        [--read 100000] [--objects 50] [--no-latency] [--json results.json]
+        [--read 100000] [--objects 50] [--runs 3] [--no-latency] [--json results.json]
 """
 
 from __future__ import annotations
@@ -181,8 +183,9 @@ def online_latency(frames: list[list], pattern: list[str], rate: float, warm_up:
     }
 
 
-def read_throughput(messages: int, objects: int) -> dict:
-    """Messages per second read by the ros-bag reader (see the module docstring)."""
+def read_throughput(messages: int, objects: int, runs: int) -> dict:
+    """Messages per second read by the ros-bag reader (see the module docstring): medians of
+    ``runs`` runs."""
     from mcap_ros2._dynamic import serialize_dynamic
 
     from scenegrep.readers.ros.bag import bag_messages
@@ -234,20 +237,27 @@ def read_throughput(messages: int, objects: int) -> dict:
                 writer.add_message(tf_channel, stamp, bytes(tf_template), stamp)
                 writer.add_message(objects_channel, stamp, bytes(template), stamp)
             writer.finish()
-        start = time.perf_counter()
-        records = sum(1 for _ in bag_messages(path))
-        stream_s = time.perf_counter() - start
-        start = time.perf_counter()
-        trace = read_trace(path)
-        read_s = time.perf_counter() - start
-    assert trace.n_frames == messages and len(trace.states) == messages * (objects + 1)
+        stream, read, cpu = [], [], []
+        for _ in range(runs):  # alternated, so both see the same load of a shared machine
+            start = time.perf_counter()
+            records = sum(1 for _ in bag_messages(path))
+            stream.append(records / (time.perf_counter() - start))
+            start, start_cpu = time.perf_counter(), time.process_time()
+            trace = read_trace(path)
+            read.append(messages / (time.perf_counter() - start))
+            cpu.append((time.process_time() - start_cpu) / messages * 1e6)
+            assert trace.n_frames == messages and len(trace.states) == messages * (objects + 1)
     return {
         "messages": messages,
         "objects_per_message": objects,
         "bytes_per_message": len(template),
-        "mcap_stream_messages_per_s": round(records / stream_s),
-        "read_messages_per_s": round(messages / read_s),
-        "read_s": round(read_s, 3),
+        "runs": runs,
+        "load_average": os.getloadavg()[0],
+        "mcap_stream_messages_per_s": round(statistics.median(stream)),
+        "read_messages_per_s": round(statistics.median(read)),
+        "read_over_stream": round(statistics.median(r / s for r, s in zip(read, stream)), 4),
+        "read_cpu_us_per_message": round(statistics.median(cpu), 2),
+        "read_messages_per_s_each_run": [round(r) for r in read],
     }
 
 
@@ -260,6 +270,7 @@ def main() -> None:
     parser.add_argument("--warm-up", type=int, default=5, help="first frames not counted")
     parser.add_argument("--read", type=int, default=0, metavar="N", help="TrackedObjects messages read (0: skip)")
     parser.add_argument("--objects", type=int, default=50, help="objects per TrackedObjects message")
+    parser.add_argument("--runs", type=int, default=3, help="read runs (medians reported)")
     parser.add_argument("--no-latency", action="store_true", help="skip the online latency")
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
@@ -273,7 +284,7 @@ def main() -> None:
             details = {"source": "TrackedObjects + /tf (AV2 7fab2350)"}
         report["online_latency"] = details | online_latency(frames, pattern, args.rate, args.warm_up)
     if args.read:
-        report["read_throughput"] = read_throughput(args.read, args.objects)
+        report["read_throughput"] = read_throughput(args.read, args.objects, args.runs)
     print(json.dumps(report, indent=2))
     if args.json:
         args.json.write_text(json.dumps(report, indent=2))

@@ -11,28 +11,15 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from typing import BinaryIO
 
-from mcap.exceptions import McapError
-from mcap.records import Channel, Chunk, Message, Schema
-from mcap.stream_reader import StreamReader, breakup_chunk
-
 from ...errors import UserError, at, first_line
+from .chunks import mcap_messages
 from .messages import RawMessage
 
 MAX_RECORD_BYTES = 1 << 30
 """The largest MCAP record or uncompressed chunk read."""
-
-MCAP_MAGIC = b"\x89MCAP0\r\n"
-
-
-@dataclass(frozen=True)
-class _Topic:
-    topic: str
-    schema: Schema | None
-    encoding: str
 
 
 def storage_files(path: Path) -> list[Path]:
@@ -47,62 +34,31 @@ def storage_files(path: Path) -> list[Path]:
     return sorted(path.glob("*.mcap"), key=number)
 
 
-def _records(stream: BinaryIO) -> Iterator[object]:
-    reader = StreamReader(stream, emit_chunks=True, record_size_limit=MAX_RECORD_BYTES)
-    for record in reader.records:
-        if isinstance(record, Chunk):
-            if record.uncompressed_size > MAX_RECORD_BYTES:
-                raise McapError(f"a chunk of {record.uncompressed_size} bytes (at most {MAX_RECORD_BYTES})")
-            yield from breakup_chunk(record)
-        else:
-            yield record
-
-
-def messages(stream: BinaryIO, source: str) -> Iterator[RawMessage]:
-    """The messages of an MCAP stream in file order (schemas and channels as they are defined)."""
-    schemas: dict[int, Schema] = {}
-    channels: dict[int, _Topic] = {}
+def messages(stream: BinaryIO, source: str, views: bool = False) -> Iterator[RawMessage]:
+    """The messages of an MCAP stream in file order (schemas and channels as they are defined);
+    with ``views`` each message's ``data`` is a memoryview into its decompressed chunk
+    (:mod:`.chunks`), else bytes."""
     last: RawMessage | None = None
     try:
-        for record in _records(stream):
-            if isinstance(record, Schema):
-                schemas[record.id] = record
-            elif isinstance(record, Channel):
-                channels[record.id] = _Topic(record.topic, schemas.get(record.schema_id), record.message_encoding)
-            elif isinstance(record, Message):
-                channel = channels.get(record.channel_id)
-                if channel is None:
-                    raise UserError(
-                        f"message at log time {record.log_time} ns on channel {record.channel_id}, never defined",
-                        at(source),
-                    )
-                schema = channel.schema
-                last = RawMessage(
-                    channel.topic,
-                    schema.name if schema else "",
-                    schema.encoding if schema else "",
-                    schema.data if schema else b"",
-                    channel.encoding,
-                    record.log_time,
-                    record.data,
-                )
-                yield last
-    except (McapError, EOFError, ValueError, KeyError, OSError) as exc:
+        for last in mcap_messages(stream, MAX_RECORD_BYTES, views):
+            yield last
+    except (ValueError, OSError) as exc:  # McapFormatError, a string not UTF-8
         after = "at its start" if last is None else f"after topic {last.topic}, message at log time {last.log_time} ns"
         detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise UserError(f"not a valid MCAP file (truncated or corrupt?) {after}: {detail}", at(source)) from None
 
 
-def bag_messages(path: str | Path) -> Iterator[RawMessage]:
+def bag_messages(path: str | Path, views: bool = False) -> Iterator[RawMessage]:
     """Every message of an MCAP file or a ROS 2 bag directory, file after file (a directory of
-    ``.db3`` files through :func:`sqlite_messages`)."""
+    ``.db3`` files through :func:`sqlite_messages`); ``views``: an MCAP message's ``data`` is a
+    memoryview into its chunk (the offline reader's batches decode it without a copy)."""
     path = Path(path)
     if path.is_dir() and not any(path.glob("*.mcap")):
         yield from sqlite_messages(path)
         return
     for file in storage_files(path):
         with open(file, "rb") as handle:
-            yield from messages(handle, str(file))
+            yield from messages(handle, str(file), views)
 
 
 def sqlite_messages(path: Path) -> Iterator[RawMessage]:

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from .cdr import Level, Payloads, decode
+from .cdr_layout import Layout, decode_same_layout
 from .foxglove import SCENE_UPDATE, decode_scene_updates
 from .messages import Boxes, ImageBoxes, RawMessage, Transforms
 from .msgdef import Field, normalise, parse_schema
@@ -341,14 +342,21 @@ def supported(schema_name: str, message_encoding: str) -> bool:
     return message_encoding == "cdr" and type_key(schema_name) in _DECODERS
 
 
+_LAYOUTS: dict[object, Layout] = {}
+"""The last layout of each schema and field set decoded (:mod:`.cdr_layout`)."""
+
+
 def decode_batch(messages: Sequence[RawMessage]) -> Boxes | ImageBoxes | Transforms:
     """The boxes or links of a batch of messages of one topic (one supported schema and encoding):
     DecodeError names the first bad message; DefinitionError a schema that cannot be read; KeyError
-    a field the decoder needs that the schema lacks."""
+    a field the decoder needs that the schema lacks. A batch of one layout is read with strided
+    views (:mod:`.cdr_layout`), any other with the generic walk: the same boxes or links."""
     first = messages[0]
     if first.schema_name == SCENE_UPDATE:
         return decode_scene_updates(messages)
     key = type_key(first.schema_name)
     wanted, build = _DECODERS[key](first.topic) if key in IMAGE_TYPES else _DECODERS[key]()
-    payloads = Payloads.of([m.data for m in messages])
-    return build(decode(types_of(first.schema_name, first.schema_data), key, payloads, wanted))
+    types = types_of(first.schema_name, first.schema_data)
+    data = [m.data for m in messages]
+    levels = decode_same_layout(types, key, wanted, data, _LAYOUTS, (first.schema_name, first.schema_data, wanted))
+    return build(levels if levels is not None else decode(types, key, Payloads.of(data), wanted))

@@ -35,7 +35,7 @@ def _number(value: Any, what: str) -> float:
 def _json_entities(data: bytes) -> list[dict]:
     """The entities of a JSON SceneUpdate as plain dicts (ValueError naming what is wrong)."""
     try:
-        document = json.loads(data)
+        document = json.loads(bytes(data))
     except (ValueError, RecursionError) as exc:
         raise ValueError(f"not JSON: {str(exc).splitlines()[0] if str(exc) else 'too deeply nested'}") from None
     if not isinstance(document, dict):
@@ -90,7 +90,7 @@ def _protobuf_decoder(schema_name: str, schema_encoding: str, schema_data: bytes
 
 
 def _protobuf_entities(message: RawMessage) -> list[dict]:
-    update = _protobuf_decoder(message.schema_name, message.schema_encoding, message.schema_data)(message.data)
+    update = _protobuf_decoder(message.schema_name, message.schema_encoding, message.schema_data)(bytes(message.data))
     out = []
     for entity in update.entities:
         cubes = [

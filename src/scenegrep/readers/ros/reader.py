@@ -37,7 +37,7 @@ def iter_chunks(
 ) -> Iterator[LabelTrace]:
     """The chunks of frames of a bag, as the pipeline completes them."""
     source = TraceSource(str(path), FORMAT)
-    yield from frames(batches(bag_messages(path)), options or current(), Path(path).stem, source, note)
+    yield from frames(batches(bag_messages(path, views=True)), options or current(), Path(path).stem, source, note)
 
 
 def read_traces(path: str | Path, options: BagOptions | None = None) -> Iterator[LabelTrace]:

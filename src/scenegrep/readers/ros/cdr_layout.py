@@ -1,0 +1,264 @@
+"""A batch of CDR messages that all have one layout, decoded with strided views.
+
+A message's *layout* is where every field is. :func:`layout` walks one message (scalar Python,
+once) and notes the byte offset of every wanted primitive and string and of every count (a
+sequence's length, a string's length). Two messages of one type whose sizes are equal and whose
+counts are equal at those offsets have the same layout: each offset depends only on the counts
+before it, and every bound the generic walk checks (a read past the end, a count too large for
+the bytes left) depends only on the counts and the size. :func:`decode_same_layout` checks
+exactly that for a whole batch with one gather, then reads every wanted field of every message
+as one strided view of the batch's rows (an item's field is at a constant step from the one
+before: one view, one copy), so the Python work is per field, not per message or object.
+
+A batch that is not of one layout, or holds a bad header, or a type this module does not walk
+(a wanted sequence of strings or primitives) gives None: the caller decodes it with
+:func:`.cdr.decode`, which also names a bad message. The levels returned are those
+:func:`.cdr.decode` gives, items in message order.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .cdr import _DTYPES, HEADER, Level, Payloads, _Walker
+from .msgdef import PRIMITIVE_SIZES, STRINGS, Field
+
+
+class Unsupported(ValueError):
+    """A message this module does not lay out: a wanted sequence of strings or primitives, or
+    one that is malformed (the generic walk names the fault)."""
+
+
+@dataclass
+class _LevelPlan:
+    """One level of a layout: per item its parent item and rank; per wanted primitive field its
+    dtype, values per item and each item's offset; per wanted string each item's offset and
+    length."""
+
+    parent_level: str
+    parent: list[int] = field(default_factory=list)
+    rank: list[int] = field(default_factory=list)
+    fields: dict[str, tuple[str, int, list[int]]] = field(default_factory=dict)
+    strings: dict[str, tuple[list[int], list[int]]] = field(default_factory=dict)
+
+
+@dataclass
+class Layout:
+    """Where things are in a message of this layout: ``size`` its CDR bytes (after the
+    encapsulation header), ``count_at`` the offsets of its counts and ``count_value`` their
+    values, ``levels`` the items and fields (offsets from the CDR origin)."""
+
+    size: int
+    count_at: np.ndarray
+    count_value: np.ndarray
+    levels: dict[str, _LevelPlan]
+
+
+def layout(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozenset[str], raw: bytes) -> Layout:
+    """The layout of one message (``raw``: its bytes after the encapsulation header); Unsupported
+    when it cannot be laid out (see :class:`Unsupported`)."""
+    plainer = _Walker(types, wanted, Payloads(np.zeros(0, np.uint8), np.zeros(0, np.int64), np.zeros(0, np.int64)))
+    prefixes = plainer._prefixes
+    counts: list[tuple[int, int]] = []
+    levels: dict[str, _LevelPlan] = {"": _LevelPlan("", [0], [0])}
+
+    def count(pos: int, least: int) -> tuple[int, int]:
+        pos = (pos + 3) & -4
+        if pos + 4 > len(raw):
+            raise Unsupported("truncated")
+        (n,) = struct.unpack_from("<I", raw, pos)
+        counts.append((pos, n))
+        if pos + 4 + n * max(least, 1) > len(raw):  # as the generic walk bounds a count
+            raise Unsupported("count too large")
+        return n, pos + 4
+
+    def walk(type_name: str, level: str, prefix: str, item: int, pos: int) -> int:
+        plan = levels[level]
+        for f in types[type_name]:
+            path = prefix + f.name
+            full = f"{level}.{path}" if level else path
+            want = full in prefixes
+            if f.type in PRIMITIVE_SIZES and f.count != -1:
+                size, k = PRIMITIVE_SIZES[f.type], 1 if f.count is None else f.count
+                if k == 0:
+                    continue
+                pos = (pos + size - 1) & -size
+                if want:
+                    plan.fields.setdefault(path, (_DTYPES[f.type], k, []))[2].append(pos)
+                pos += size * k
+            elif f.count is None and f.type in STRINGS:
+                n, pos = count(pos, 0)
+                if want:
+                    spots = plan.strings.setdefault(path, ([], []))
+                    spots[0].append(pos)
+                    spots[1].append(n)
+                pos += n
+            elif f.count is None:
+                plain = plainer.plain(f.type)
+                if plain is not None and not want:
+                    pos = ((pos + plain[1] - 1) & -plain[1]) + plain[0]
+                else:
+                    pos = walk(f.type, level, path + ".", item, pos)
+            else:
+                element = PRIMITIVE_SIZES.get(f.type) or (None if f.type in STRINGS else plainer.plain(f.type))
+                element = (element, element) if isinstance(element, int) else element
+                n, pos = count(pos, element[0] if element else 1) if f.count == -1 else (f.count, pos)
+                if element is not None and not want:
+                    pos = (((pos + element[1] - 1) & -element[1]) if n else pos) + n * element[0]
+                elif f.type in STRINGS or f.type in PRIMITIVE_SIZES:
+                    raise Unsupported(full)
+                else:
+                    sub = levels.setdefault(full, _LevelPlan(level))
+                    for j in range(n):
+                        sub.parent.append(item)
+                        sub.rank.append(j)
+                        pos = walk(f.type, full, "", len(sub.parent) - 1, pos)
+            if pos > len(raw):
+                raise Unsupported("truncated")
+        return pos
+
+    walk(type_name, "", "", 0, 0)
+    at = np.array([c[0] for c in counts], dtype=np.int64)
+    return Layout(len(raw), at, np.array([c[1] for c in counts], dtype=np.uint32), levels)
+
+
+@dataclass(frozen=True)
+class _Group:
+    """Messages of a batch that lie in one buffer (one decompressed chunk): ``base`` its bytes,
+    ``origins`` each message's CDR origin in it (after its header), ``stride`` the constant step
+    between them (0 for one message), None when they are not evenly spaced."""
+
+    base: np.ndarray
+    origins: np.ndarray
+    stride: int | None
+
+
+def _group(base: np.ndarray, origins: np.ndarray) -> _Group:
+    steps = np.diff(origins)
+    stride = 0 if not len(steps) else int(steps[0]) if (steps == steps[0]).all() and steps[0] > 0 else None
+    return _Group(base, origins, stride)
+
+
+def _groups(payloads: Sequence) -> list[_Group] | None:
+    """The batch as runs of messages sharing one buffer (memoryviews of one chunk; bytes are
+    copied into one buffer), or None when the payloads' sizes differ or one lacks the
+    little-endian CDR encapsulation header."""
+    size = len(payloads[0])
+    if size < HEADER or any(len(p) != size for p in payloads):
+        return None
+    if not all(isinstance(p, memoryview) for p in payloads):
+        base = np.frombuffer(b"".join(payloads), dtype=np.uint8)
+        groups = [_group(base, np.arange(len(payloads), dtype=np.int64) * size + HEADER)]
+    else:
+        owners = [p.obj for p in payloads]
+        cuts = [0, *(i for i in range(1, len(owners)) if owners[i] is not owners[i - 1]), len(owners)]
+        groups = []
+        for start, end in zip(cuts, cuts[1:]):
+            base = np.frombuffer(owners[start], dtype=np.uint8)
+            origin = base.__array_interface__["data"][0] - HEADER
+            at = [np.frombuffer(p, np.uint8).__array_interface__["data"][0] - origin for p in payloads[start:end]]
+            groups.append(_group(base, np.array(at, dtype=np.int64)))
+    for g in groups:
+        if (g.base[g.origins - HEADER] != 0).any() or (g.base[g.origins - HEADER + 1] != 1).any():
+            return None
+    return groups
+
+
+def _values(group: _Group, at: np.ndarray, dtype: str, k: int) -> np.ndarray:
+    """Per message of ``group``, ``k`` values of ``dtype`` at each of the CDR offsets ``at``:
+    shape (messages, len(at), k); one strided view where the places are evenly spaced."""
+    size = np.dtype(dtype).itemsize
+    n, spots = len(group.origins), len(at)
+    step = int(at[1] - at[0]) if spots > 1 else 0
+    if group.stride is not None and spots and np.array_equal(at, at[0] + step * np.arange(spots)):
+        strides = (group.stride, step, size)
+        return np.ndarray((n, spots, k), dtype, group.base, int(group.origins[0] + at[0]), strides).copy()
+    columns = (at[:, None] + np.arange(size * k)).ravel()
+    return group.base[group.origins[:, None] + columns].view(dtype).reshape(n, spots, k)
+
+
+def matches(plan: Layout, groups: list[_Group]) -> bool:
+    """Whether every message of ``groups`` (all of the plan's size) has the layout ``plan``."""
+    return all((_values(g, plan.count_at, "<u4", 1)[:, :, 0] == plan.count_value).all() for g in groups)
+
+
+def _strings(groups: list[_Group], at: list[int], lengths: list[int]) -> np.ndarray:
+    """Per message, the string at each offset (of its length): item order (message, then
+    offset); decoded once per distinct value, as the generic walk decodes each."""
+    n, m = sum(len(g.origins) for g in groups), len(at)
+    texts = np.empty(n * m, dtype=object)
+    for j, (pos, length) in enumerate(zip(at, lengths)):
+        if not length:
+            texts[j::m] = ""
+            continue
+        raw = np.concatenate([_values(g, np.array([pos]), f"V{length}", 1).ravel() for g in groups])
+        unique, inverse = np.unique(raw, return_inverse=True)
+        decoded = np.array([bytes(u).rstrip(b"\0").decode("utf-8", "replace") for u in unique], dtype=object)
+        texts[j::m] = decoded[inverse.ravel()]
+    return texts
+
+
+def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level]:
+    """The levels of the messages of ``groups`` (every one of layout ``plan``: check
+    :func:`matches` first), in message order. Every field of a group is read before the next
+    group (its chunk is then still in cache)."""
+    n = sum(len(g.origins) for g in groups)
+    spots = {
+        (name, path): np.array(at, dtype=np.int64)
+        for name, p in plan.levels.items()
+        for path, (_, _, at) in p.fields.items()
+    }
+    parts = [
+        {
+            (name, path): _values(g, spots[name, path], dtype, k)
+            for name, p in plan.levels.items()
+            for path, (dtype, k, _) in p.fields.items()
+        }
+        for g in groups
+    ]
+    sizes = {name: len(p.parent) for name, p in plan.levels.items()}
+    out: dict[str, Level] = {}
+    for name, p in plan.levels.items():
+        m = len(p.parent)
+        message = np.repeat(np.arange(n, dtype=np.int64), m)
+        parent = message
+        if name:
+            parent = message * sizes[p.parent_level] + np.tile(np.array(p.parent, dtype=np.int64), n)
+        fields: dict[str, np.ndarray] = {}
+        for path, (_, k, _) in p.fields.items():
+            values = np.concatenate([part[name, path] for part in parts])
+            fields[path] = values.reshape(n * m) if k == 1 else values.reshape(n * m, k)
+        for path, (at, lengths) in p.strings.items():
+            fields[path] = _strings(groups, at, lengths)
+        out[name] = Level(parent, np.tile(np.array(p.rank, dtype=np.int64), n), fields)
+    return out
+
+
+def decode_same_layout(
+    types: dict[str, tuple[Field, ...]],
+    type_name: str,
+    wanted: frozenset[str],
+    payloads: Sequence,
+    cache: dict[object, Layout],
+    key: object,
+) -> dict[str, Level] | None:
+    """The levels of a batch of one layout (that of ``cache[key]``, else of its first message,
+    then kept there), or None when the batch is not of one layout (see the module docstring).
+    ``payloads``: each message's bytes or a memoryview into its chunk (read in place)."""
+    groups = _groups(payloads)
+    if groups is None:
+        return None
+    plan = cache.get(key)
+    if plan is None or plan.size != len(payloads[0]) - HEADER or not matches(plan, groups):
+        try:
+            plan = layout(types, type_name, wanted, bytes(payloads[0][HEADER:]))
+        except Unsupported:
+            return None
+        cache[key] = plan
+        if not matches(plan, groups):
+            return None
+    return decode_groups(plan, groups)

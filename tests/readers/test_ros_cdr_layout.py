@@ -1,0 +1,166 @@
+"""The one-layout CDR decoder (:mod:`scenegrep.readers.ros.cdr_layout`) against the generic walk,
+through real MCAP files: random TrackedObjects drawn from one or two layouts (so batches of one
+layout and mixed batches both occur, also inside one chunk), other messages of random sizes
+between them (so a chunk's messages are evenly spaced or not), small chunks, every
+compression; read in place from the chunks. A batch is decoded on the fast path exactly when
+every message has one layout, and then to the boxes the generic walk gives; a bad message in
+a batch of one layout is still the generic walk's one-line error naming topic and log time."""
+
+from __future__ import annotations
+
+import io
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from mcap.writer import CompressionType, Writer
+
+from scenegrep import readers
+from scenegrep.errors import UserError
+from scenegrep.readers.ros.cdr import Payloads, decode
+from scenegrep.readers.ros.cdr_layout import Unsupported, decode_same_layout, layout
+from scenegrep.readers.ros.chunks import mcap_messages
+from scenegrep.readers.ros.decoders import _DECODERS, decode_batch, type_key, types_of
+
+from .ros_writer import schema
+from .test_ros_cdr import NAME, _message, obj
+
+KEY = type_key(NAME)
+TYPES = types_of(NAME, schema(NAME).encode())
+WANTED, BUILD = _DECODERS[KEY]()
+FIELDS = ("message", "stamp", "frame_id", "id", "category", "xyz", "quat", "size", "velocity", "message_stamps")
+TOPIC = "/objects"
+
+
+def _shape(objects: list[dict]) -> tuple:
+    return tuple((len(o["classes"]), o["points"]) for o in objects)
+
+
+def _mcap(items: list[tuple[str, int, bytes]], compression=CompressionType.ZSTD, chunk_size: int = 1 << 20) -> bytes:
+    """An MCAP file of (topic, log time, data): TOPIC as TrackedObjects, others as raw bytes."""
+    out = io.BytesIO()
+    writer = Writer(out, chunk_size=chunk_size, compression=compression)
+    writer.start("ros2", "test")
+    channels: dict[str, int] = {}
+    for topic, log_time, data in items:
+        if topic not in channels:
+            name, text = (NAME.replace("/", "/msg/"), schema(NAME)) if topic == TOPIC else ("pkg/msg/Other", "int8 x")
+            registered = writer.register_schema(name, "ros2msg", text.encode())
+            channels[topic] = writer.register_channel(topic, "cdr", registered)
+        writer.add_message(channels[topic], log_time=log_time, data=data, publish_time=log_time)
+    writer.finish()
+    return out.getvalue()
+
+
+def _same_boxes(fast, slow) -> None:
+    for name in FIELDS:
+        np.testing.assert_array_equal(getattr(fast, name), getattr(slow, name), err_msg=name)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.lists(st.lists(obj, max_size=3), min_size=1, max_size=2),
+    st.lists(st.tuples(st.integers(0, 1), st.integers(0, 10**6), st.integers(-1, 40)), min_size=1, max_size=8),
+    st.sampled_from(["map", "base_link"]),
+    st.sampled_from([CompressionType.NONE, CompressionType.LZ4, CompressionType.ZSTD]),
+    st.integers(1, 3000),
+    st.booleans(),
+)
+def test_batches_read_in_place_decode_as_the_generic_walk(pool, picks, frame, compression, chunk_size, stale):
+    chosen = [pool[k % len(pool)] for k, _, _ in picks]
+    items = []
+    for i, (objects, (_, sec, other)) in enumerate(zip(chosen, picks)):
+        items.append((TOPIC, i, _message(objects, sec, frame)))
+        if other >= 0:  # another topic's message between them: their spacing in a chunk changes
+            items.append(("/other", i, bytes(other)))
+    found = [m for m in mcap_messages(io.BytesIO(_mcap(items, compression, chunk_size)), 1 << 24, True)]
+    payloads = [m.data for m in found if m.topic == TOPIC]
+    assert all(isinstance(p, memoryview) for p in payloads)
+    # a cache holding the other layout of the pool first, or nothing
+    cache = {}
+    if stale and len(pool) > 1:
+        cache["k"] = layout(TYPES, KEY, WANTED, _message(pool[1], 0, frame)[4:])
+    levels = decode_same_layout(TYPES, KEY, WANTED, payloads, cache, "k")
+    slow = BUILD(decode(TYPES, KEY, Payloads.of([bytes(p) for p in payloads]), WANTED))
+    assert (levels is not None) == all(_shape(o) == _shape(chosen[0]) for o in chosen)
+    if levels is not None:
+        _same_boxes(BUILD(levels), slow)
+    _same_boxes(decode_batch([m for m in found if m.topic == TOPIC]), slow)
+
+
+def _equal_sizes() -> tuple[list[dict], list[dict]]:
+    """Two one-object messages of equal size and different layouts (classes and points)."""
+    one = {"xyz": (1.0, 2.0, 3.0), "size": (4.0, 2.0, 1.5), "uuid": b"u" * 16}
+    sizes: dict[int, list[dict]] = {}
+    for classes in range(4):
+        for points in range(5):
+            o = one | {"classes": [(1, 0.5)] * classes, "points": points}
+            size = len(_message([o], 0, "map"))
+            if size in sizes:
+                return sizes[size], [o]
+            sizes[size] = [o]
+    raise AssertionError("no two layouts of one size")
+
+
+def test_equal_sizes_with_other_counts_are_not_one_layout():
+    a, b = _equal_sizes()
+    raw = [_message(a, 1, "map"), _message(b, 2, "map")]
+    assert len(raw[0]) == len(raw[1])
+    assert decode_same_layout(TYPES, KEY, WANTED, [memoryview(r) for r in raw], {}, "k") is None
+    slow = BUILD(decode(TYPES, KEY, Payloads.of(raw), WANTED))
+    _same_boxes(decode_batch([_raw(r, i) for i, r in enumerate(raw)]), slow)
+
+
+def _raw(data: bytes, log_time: int):
+    from scenegrep.readers.ros.messages import RawMessage
+
+    return RawMessage(TOPIC, NAME, "ros2msg", schema(NAME).encode(), "cdr", log_time, memoryview(data))
+
+
+def test_a_truncated_message_has_no_layout():
+    raw = _message(
+        [{"xyz": (1, 2, 3), "size": (1, 1, 1), "classes": [(1, 0.5)], "points": 2, "uuid": b"u" * 16}], 5, "map"
+    )
+    for cut in (3, 40, len(raw) - 5):
+        with pytest.raises(Unsupported, match="truncated"):
+            layout(TYPES, KEY, WANTED, raw[4:cut])
+    hostile = bytearray(raw)
+    hostile[20:24] = struct.pack("<I", 2**31)  # the object count (frame id "map": after 16 bytes of CDR)
+    with pytest.raises(Unsupported, match="count too large"):
+        layout(TYPES, KEY, WANTED, bytes(hostile[4:]))
+
+
+OBJECTS = [{"xyz": (k, 2.0, 0.0), "size": (4.0, 2.0, 1.5), "classes": [(1, 0.9)], "points": 0} for k in range(3)]
+UNIFORM = [_message([o | {"uuid": bytes([k]) * 16} for k, o in enumerate(OBJECTS)], 100 + i, "map") for i in range(30)]
+
+
+@pytest.mark.parametrize(
+    "damage",
+    [
+        lambda data: data[:-9],  # truncated: its size differs from the others'
+        lambda data: data[:20] + struct.pack("<I", 2**30) + data[24:],  # same size, hostile object count
+        lambda data: b"\0\0" + data[2:],  # big-endian header
+    ],
+    ids=["truncated", "count too large", "header"],
+)
+def test_a_bad_message_in_a_uniform_chunk_is_the_generic_error(tmp_path: Path, damage):
+    path = tmp_path / "bad.mcap"
+    bad = [(TOPIC, 1_000 + i, damage(data) if i == 17 else data) for i, data in enumerate(UNIFORM)]
+    path.write_bytes(_mcap(bad))
+    with pytest.raises(UserError) as error:
+        readers.read_trace(path, "ros-bag")
+    line = error.value.one_line()
+    assert "\n" not in line and f"topic {TOPIC}, message at log time {1_017} ns:" in line
+
+
+def test_a_message_of_the_same_size_and_another_count_is_read_as_the_generic_walk_reads_it(tmp_path: Path):
+    path = tmp_path / "fewer.mcap"
+    messages = list(UNIFORM)
+    messages[17] = messages[17][:20] + struct.pack("<I", 2) + messages[17][24:]  # one object fewer, same bytes
+    path.write_bytes(_mcap([(TOPIC, 1_000 + i, data) for i, data in enumerate(messages)]))
+    trace = readers.read_trace(path, "ros-bag")
+    per_frame = np.bincount(trace.states.frame, minlength=trace.n_frames)
+    assert per_frame.tolist() == [3] * 17 + [2] + [3] * 12

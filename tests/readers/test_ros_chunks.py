@@ -173,3 +173,16 @@ def test_a_message_on_an_undefined_channel_and_no_magic():
     # the channel record renamed to an unknown opcode: the message's channel is never defined
     bad = data[:channel_at] + b"\x7f" + data[channel_at + 1 :]
     assert "never defined" in _one_line(bad)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.floats(0, 1, exclude_max=True), st.integers(0, 255)), min_size=1, max_size=4))
+def test_flipped_bytes_are_messages_or_a_one_line_error(good, flips):
+    bad = bytearray(good)
+    for where, value in flips:
+        bad[int(len(bad) * where)] = value
+    try:
+        for m in bag_stream(io.BytesIO(bytes(bad)), "f.mcap", True):
+            assert isinstance(m.data, memoryview)
+    except UserError as error:
+        assert "\n" not in error.one_line()

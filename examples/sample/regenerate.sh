@@ -10,7 +10,7 @@ scenegrep=${SCENEGREP:-scenegrep}
 
 rm -f "$here"/*.parquet "$here"/manifest.json
 synth() {  # PROGRAM MAP
-    "$scenegrep" synth "$examples/scenarios/$1.scenic" --map "$examples/maps/$2.xodr" \
+    "$scenegrep" synth "$examples/scenarios/$1.scenic" --map "$here/$2.xodr" \
         --runs 6 --steps 150 --seed 0 -o "$here"
 }
 synth fig1_lane_change Town06

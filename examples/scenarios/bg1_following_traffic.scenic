@@ -2,7 +2,7 @@
 # lanes on a multi-lane road at the same target speed (a leader ahead of the ego on its lane,
 # a neighbour beside the ego on the lane to its left, running the same way), far from
 # junctions. Nobody stops, changes lanes or turns.
-# Map: Town06 (examples/maps/Town06.xodr).
+# Map: Town06 (examples/sample/Town06.xodr).
 # Expected primitive behaviours: FollowLane for every car.
 model scenic.simulators.newtonian.driving_model
 

@@ -1,6 +1,6 @@
 # Background traffic, matching none of seed 000's accuracy scenarios: a car follows its lane
 # past a pedestrian who stands still on the sidewalk beside the road ahead.
-# Map: Town01 (examples/maps/Town01.xodr; it has sidewalks).
+# Map: Town01 (examples/sample/Town01.xodr; it has sidewalks).
 # Expected primitive behaviours: ego FollowLane; pedestrian Stationary (no behaviour).
 model scenic.simulators.newtonian.driving_model
 

@@ -1,7 +1,7 @@
 # Seed 000, Fig. 1: the ego follows its lane and, once the other car (stationary, on the ego's
 # lane ahead) is within a distance drawn from Range(1, 15) m (re-drawn at every step), changes
 # to the lane on its left and follows that lane.
-# Map: Town06 (examples/maps/Town06.xodr): multi-lane roads; the lane on the left must run
+# Map: Town06 (examples/sample/Town06.xodr): multi-lane roads; the lane on the left must run
 # the same way as the ego's.
 # Expected primitive behaviours: ego FollowLane -> LaneChange -> FollowLane; otherCar Stationary.
 model scenic.simulators.newtonian.driving_model

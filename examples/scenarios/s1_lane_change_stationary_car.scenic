@@ -2,7 +2,7 @@
 # to avoid a stationary car in front. A stationary car is on the ego's lane ahead, visible from
 # the ego; the ego follows its lane by default and changes to the lane on its right once the
 # stationary car is within 1 to 15 m.
-# Map: Town06 (examples/maps/Town06.xodr): multi-lane roads; the lane on the right must run
+# Map: Town06 (examples/sample/Town06.xodr): multi-lane roads; the lane on the right must run
 # the same way as the ego's.
 # Expected primitive behaviours: ego FollowLane -> LaneChange -> FollowLane; parkedCar Stationary.
 model scenic.simulators.newtonian.driving_model

@@ -3,7 +3,7 @@
 # then turns left. The ego stands at the end of its lane until it no longer sees the oncoming
 # car within 40 m (the appendix says 20 m, but the stop lines of Town01's junctions are 23 m
 # apart), then follows the left-turn trajectory through the junction.
-# Map: Town01 (examples/maps/Town01.xodr; its junctions are T-junctions).
+# Map: Town01 (examples/sample/Town01.xodr; its junctions are T-junctions).
 # Expected primitive behaviours: ego Stationary -> FollowTrajectory -> Turn (inside the
 # junction) -> FollowTrajectory (-> FollowLane once the trajectory ends); otherCar FollowLane
 # (straight through the junction).

@@ -2,7 +2,7 @@
 # pedestrian walking along the ego's lane. The ego follows its lane until the pedestrian is
 # within 1 to 15 m, then follows the lane at a lower target speed until it has passed them.
 # The pedestrian walks near the lane's right edge, so the car passes beside them.
-# Map: Town01 (examples/maps/Town01.xodr).
+# Map: Town01 (examples/sample/Town01.xodr).
 # Note: Scenic 3.1.1's RegulatedControlAction never brakes (its brake is always 0), so in the
 # Newtonian simulator a lower target speed makes FollowLaneBehavior coast, not brake.
 # Expected primitive behaviours: ego FollowLane throughout; pedestrian WalkAlongLane.

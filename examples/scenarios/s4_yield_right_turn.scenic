@@ -6,7 +6,7 @@
 # The ego never follows its lane within 11 m of the junction: there FollowLaneBehavior would
 # pick a turn of its own. Scenic 3.1.1's RegulatedControlAction never brakes, so the slower
 # FollowLaneBehavior coasts; StationaryBehavior brakes fully.
-# Map: Town01 (examples/maps/Town01.xodr; the ego comes from the stem of a T-junction).
+# Map: Town01 (examples/sample/Town01.xodr; the ego comes from the stem of a T-junction).
 # Expected primitive behaviours: ego FollowLane -> Stationary -> FollowTrajectory -> Turn
 # (inside the junction) -> FollowTrajectory (-> FollowLane once the trajectory ends);
 # otherCar FollowLane.

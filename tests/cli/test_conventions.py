@@ -176,7 +176,7 @@ def test_scenario_window_after_the_program_runs(tmp_path, capsys):
 
 
 SHARED = {
-    options.add_map_argument: ("coverage", "label", "scenario", "scene"),
+    options.add_map_argument: ("coverage", "ingest", "label", "scenario", "scene"),
     options.add_tolerance_arguments: ("coverage", "scenario", "scene"),
     options.add_unknown_layers_argument: ("coverage", "ingest", "label", "scenario", "scene"),
     options.add_results_arguments: ("scenario", "scene", "spre"),

@@ -246,8 +246,8 @@ def test_coverage_over_a_dataset_equals_coverage_over_its_files(tmp_path, output
     data.mkdir()
     for f in FILES:
         shutil.copy(f, data / f.name)
-    maps = tmp_path / "maps"
-    shutil.copytree(REPO / "examples" / "maps", maps)
+    for town in ("Town01.xodr", "Town06.xodr"):
+        shutil.copy(REPO / "examples" / "sample" / town, data / town)
     ingest([str(data)], tmp_path / "ds", jobs=1)
     code = main(
         [

@@ -248,7 +248,7 @@ def test_a_file_that_does_not_validate_is_not_written(tmp_path, monkeypatch):
 
 
 def test_the_road_file_is_relative_to_the_output_file_and_output_is_deterministic(tmp_path):
-    town = REPO / "examples" / "maps" / "Town06.xodr"
+    town = REPO / "examples" / "sample" / "Town06.xodr"
     shown = moment(path("ego", program="ego"), map_source=MapSource(str(town), "opendrive"))
     first = ox.write_openscenario([shown], tmp_path / "a" / "b", CREATED).files[0]
     road = read_back(first)["road"]
@@ -355,7 +355,7 @@ def assert_raw_states(back: dict, source: str, start: int, end: int) -> None:
 
 
 def test_sample_scene_and_scenario_matches_reference_the_opendrive_map(sample_results, tmp_path, capsys):
-    town = (REPO / "examples" / "maps" / "Town06.xodr").resolve()
+    town = (REPO / "examples" / "sample" / "Town06.xodr").resolve()
     for name, results in sample_results.items():
         out = tmp_path / name
         shown, err = export(results, out, 30.0, capsys)

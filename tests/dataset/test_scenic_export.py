@@ -38,7 +38,7 @@ from scenegrep.model.taxonomy import kind_of
 from tests.conftest import REPO
 
 SAMPLE = REPO / "examples" / "sample"
-TOWN01 = REPO / "examples" / "maps" / "Town01.xodr"
+TOWN01 = REPO / "examples" / "sample" / "Town01.xodr"
 
 CLASSES = {
     "car": "Car",

@@ -31,7 +31,7 @@ WINDOW = STEPS // 2
 
 def simulated(name, runs, seed):
     program = REPO / "examples" / "scenarios" / f"{name}.scenic"
-    town = REPO / "examples" / "maps" / f"{SCENARIOS.get(name, 'Town01')}.xodr"
+    town = REPO / "examples" / "sample" / f"{SCENARIOS.get(name, 'Town01')}.xodr"
     return list(simulate_runs(program, map_path=town, runs=runs, steps=STEPS, seed=seed))
 
 

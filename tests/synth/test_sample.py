@@ -2,6 +2,7 @@
 repository, and each program's traces show the behaviours its header promises."""
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -10,7 +11,7 @@ from scenegrep.readers import read_trace
 from tests.conftest import REPO
 
 SAMPLE = REPO / "examples" / "sample"
-MAPS = REPO / "examples" / "maps"
+MAPS = SAMPLE
 EGO_BEHAVIOURS = {
     "fig1_lane_change": ["FollowLane", "LaneChange", "FollowLane"],
     "s1_lane_change_stationary_car": ["FollowLane", "LaneChange", "FollowLane"],
@@ -45,3 +46,17 @@ def test_trace_loads_with_labels_and_a_map_in_the_repository(path):
     labels = [sorted(trace.behaviours.sets()[i])[0] for i in (trace.states.object == 0).nonzero()[0]]
     ego_runs = [v for k, v in enumerate(labels) if k == 0 or v != labels[k - 1]]
     assert ego_runs == EGO_BEHAVIOURS[path.stem.rsplit("-", 1)[0]]
+
+
+def test_the_sample_folder_copied_anywhere_ingests_all_42_traces_with_its_maps(tmp_path, capsys):
+    """Relocatable: each trace names a map beside it, so a copy of the folder is self-contained."""
+    from scenegrep.cli.main import main
+    from scenegrep.dataset import open_dataset
+
+    copy = tmp_path / "elsewhere" / "sample"
+    shutil.copytree(SAMPLE, copy)
+    assert main(["ingest", str(copy), "--into", str(tmp_path / "fleet"), "-j", "1"]) == 0
+    assert "42 sources ingested (42 traces), 0 unchanged, 0 failed" in capsys.readouterr().err
+    maps = open_dataset(tmp_path / "fleet").sql("SELECT source_path FROM maps").column(0).to_pylist()
+    assert sorted(Path(m).name for m in maps) == ["Town01.xodr", "Town06.xodr"]
+    assert all(Path(m).parent == copy.resolve() for m in maps)

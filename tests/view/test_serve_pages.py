@@ -31,7 +31,7 @@ def small(tmp_path: Path) -> tuple[Path, str, str]:
     """A dataset of two sample traces (their map beside them, as in examples/) with one SpRE run:
     its folder, a trace id and the run id; a results table lies at its top (not a run's)."""
     (tmp_path / "in" / "sample").mkdir(parents=True)
-    shutil.copytree(REPO / "examples" / "maps", tmp_path / "in" / "maps")
+    shutil.copy(REPO / "examples" / "sample" / "Town06.xodr", tmp_path / "in" / "sample")
     for name in TRACES:
         shutil.copy(REPO / "examples" / "sample" / name, tmp_path / "in" / "sample")
     root = tmp_path / "fleet"

@@ -14,7 +14,7 @@ import sys
 from typing import Any
 
 from .exit_codes import EXIT_SOME_FAILED
-from .options import add_jobs_argument, add_unknown_layers_argument, report_unknown_layers
+from .options import add_jobs_argument, add_map_argument, add_unknown_layers_argument, report_unknown_layers
 
 
 def add_parser(subparsers: Any) -> None:
@@ -35,6 +35,7 @@ def add_parser(subparsers: Any) -> None:
     parser.add_argument("--no-label", action="store_true", help="do not label traces without behaviour labels")
     parser.add_argument("-q", "--quiet", action="store_true", help="print only errors")
     add_unknown_layers_argument(parser)
+    add_map_argument(parser)
     parser.set_defaults(run=run)
 
 
@@ -50,6 +51,7 @@ def run(args: argparse.Namespace) -> int:
             not args.no_label,
             on_outcome=lambda _: bar.update(),
             unknown_layers=args.unknown_layers,
+            map_path=args.map,
         )
     for path, error in report.failed:
         print(f"scenegrep: error: {error if error.startswith(path) else f'{path}: {error}'}", file=sys.stderr)

@@ -55,8 +55,9 @@ def run(args: argparse.Namespace) -> int:
     from ..progress import bar
 
     choice = unknown_layers_of(args)
-    fixed_map = readers.read_map(args.map) if args.map else None
-    labelling = FolderLabelling(Path(args.output), load_config(args.config), fixed_map, args.min_confidence, choice)
+    if args.map:
+        readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
+    labelling = FolderLabelling(Path(args.output), load_config(args.config), args.map, args.min_confidence, choice)
     with bar(desc="labelling", unit=" traces", quiet=args.quiet, delay=0.5) as progress:
         code = each_input(args.data, lambda path: labelling.label_input(path, progress.update))
     statistics = labelling.statistics

@@ -36,7 +36,10 @@ from typing import Any
 
 from ..errors import UserError
 
-MAP_HELP = "road map for traces without one (e.g. an .xodr or a Lanelet2 .osm file)"
+MAP_HELP = (
+    "road map for traces without one (e.g. an .xodr or a Lanelet2 .osm file); a trace with its own map and --map "
+    "is an error"
+)
 
 UNKNOWN_LAYERS = ("permissive", "strict")
 """The choices (as :data:`scenegrep.model.layers.MODES`, repeated so ``--help`` imports nothing)."""

@@ -47,9 +47,10 @@ def query_files(
     paths: list[str], spec: QuerySpec, map_path: str | None = None, on_rows: RowsCallback | None = None
 ) -> Results:
     """Run ``spec`` over every trace under ``paths``; ``map_path`` is the road map of traces
-    without their own. ``on_rows`` sees each trace's rows (a failed path's or source's row), with
-    every column, as soon as they are ready. The results are ordered as a dataset run's, with its
-    run id, and count the decisions the choice for unknown map layers affected, as a run's do."""
+    without their own (:mod:`scenegrep.readers.given_map`: a trace naming its own map fails with it). ``on_rows``
+    sees each trace's rows (a failed path's or source's row), with every column, as soon as they
+    are ready. The results are ordered as a dataset run's, with its run id, and count the
+    decisions the choice for unknown map layers affected, as a run's do."""
     sources, bad = discover(paths)
     tables, assumed = decisions_while(spec, lambda: _tables(spec, sources, bad, map_path, on_rows))
     table = pa.concat_tables([results_table([]), *tables]).sort_by(ORDER)
@@ -76,15 +77,13 @@ def _tables(
 def read_queried_trace(
     source: str, trace_id: str, map_path: str | None = None, unknown_layers: str | None = None
 ) -> tuple[LabelTrace, RoadMap | None]:
-    """The trace ``trace_id`` of a query over files and its road map (its own, else ``map_path``'s),
+    """The trace ``trace_id`` of a query over files and its road map (its own, else ``map_path``'s:
+    :mod:`scenegrep.readers.given_map`),
     read from its ``source`` as the query read it, labelled under the query's choice for unknown
     map layers (UserError if the source no longer holds it)."""
     for number, trace in enumerate(readers.read_traces(source)):
         if trace_id_of(source, trace.name, number) == trace_id:
-            prepared, road_map = prepare_trace(trace, label=True, unknown_layers=UnknownLayers(unknown_layers))
-            if road_map is None and map_path:
-                road_map = readers.read_map(map_path)
-            return prepared, road_map
+            return prepare_trace(trace, True, UnknownLayers(unknown_layers), map_path)
     raise UserError(f"holds no trace {trace_id!r} (changed since the query?)", at(source))
 
 
@@ -125,13 +124,13 @@ def _trace_rows(
 
     def rows() -> list[dict[str, Any]]:
         labelled = spec.kind == "scenario"
-        prepared, road_map = prepare_trace(trace, labelled, spec_choice(spec)) if uses_map(spec) else (trace, None)
+        prepared, road_map = (
+            prepare_trace(trace, labelled, spec_choice(spec), map_path) if uses_map(spec) else (trace, None)
+        )
         row, statistics = catalog_row(prepared, trace_id, source, "", None)
         reason = planner.prune_reason(row, statistics)
         if reason is not None:
             return [pruned_row(reason)]
-        if road_map is None and map_path:
-            road_map = readers.read_map(map_path)
         return match_trace(spec, prepared, road_map)
 
     return query_trace(identity, source, rows)

@@ -54,13 +54,15 @@ class Source:
 class IngestTask:
     """What a worker needs to ingest one source: it, the dataset root, the checksum the
     catalog has for it (None if new), whether to label traces without behaviour labels, and the
-    labeller's choice for map layers a map does not publish (see :mod:`scenegrep.model.layers`)."""
+    labeller's choice for map layers a map does not publish (see :mod:`scenegrep.model.layers`), and
+    the road map of traces without one (``--map``, :mod:`scenegrep.readers.given_map`)."""
 
     source: Source
     root: str
     known_checksum: str | None
     label: bool
     unknown_layers: str | None = None
+    map_path: str | None = None
 
 
 @dataclass
@@ -160,13 +162,16 @@ def checksum(path: str) -> str:
     return digest.hexdigest()
 
 
-def source_key(path: str, label: bool) -> str:
-    """What the catalog keeps to tell an unchanged source: its :func:`checksum` and, when ingest
-    labels its traces, the labeller's version (labels of an older labeller are not reused)."""
+def source_key(path: str, label: bool, map_path: str | None = None) -> str:
+    """What the catalog keeps to tell an unchanged source: its :func:`checksum`, when ingest
+    labels its traces the labeller's version (labels of an older labeller are not reused), and
+    the checksum of a ``--map`` (traces ingested with another map are not reused)."""
     from ..label import LABELLER_VERSION
 
     digest = checksum(path)
-    return f"{digest} labeller {LABELLER_VERSION}" if label else digest
+    if label:
+        digest = f"{digest} labeller {LABELLER_VERSION}"
+    return digest if map_path is None else f"{digest} map {checksum(map_path)}"
 
 
 def _slug(text: str) -> str:
@@ -189,7 +194,7 @@ def ingest_source(task: IngestTask) -> SourceOutcome:
     maps and compute their statistics. Any failure becomes a 'failed' outcome."""
     source = task.source
     try:
-        digest = source_key(source.path, task.label)
+        digest = source_key(source.path, task.label, task.map_path)
         if digest == task.known_checksum:
             return SourceOutcome(source, "unchanged", digest)
         outcome = SourceOutcome(source, "ingested", digest, replaces=task.known_checksum is not None)
@@ -203,12 +208,14 @@ def ingest_source(task: IngestTask) -> SourceOutcome:
 
 
 def prepare_trace(
-    trace: LabelTrace, label: bool, unknown_layers: UnknownLayers | None = None
+    trace: LabelTrace, label: bool, unknown_layers: UnknownLayers | None = None, map_path: str | None = None
 ) -> tuple[LabelTrace, RoadMap | None]:
-    """A trace as a dataset holds it, and its own road map (None when it names none): when
-    ``label`` and it has no behaviour labels, labelled with that map by ``scenegrep label``'s
-    labeller, under the choice ``unknown_layers`` for map layers the map does not publish. Ingest
-    and a query over files both read traces this way."""
+    """A trace as a dataset holds it, and its road map (None when it has none): its own, or
+    ``map_path`` (``--map``) when it names none (:mod:`scenegrep.readers.given_map`: a trace naming its own map and
+    a ``map_path`` is a UserError); when ``label`` and it has no behaviour labels, labelled with that
+    map by ``scenegrep label``'s labeller, under the choice ``unknown_layers`` for map layers the
+    map does not publish. Ingest and a query over files both read traces this way."""
+    trace = with_given_map(trace, map_path)
     road_map = None if trace.map_source is None else readers.read_map(trace.map_source)
     if label:
         trace = labelled(trace, road_map, unknown_layers)
@@ -243,7 +250,7 @@ def _write_trace(
 
     root = Path(task.root)
     recorded = labelling_choice(trace, task.label, choice)
-    trace, road_map = prepare_trace(trace, task.label, choice)
+    trace, road_map = prepare_trace(trace, task.label, choice, task.map_path)
     map_id = None
     if road_map is not None:
         ms = trace.map_source
@@ -273,11 +280,15 @@ def ingest(
     label: bool = True,
     on_outcome: Callable[[SourceOutcome], None] | None = None,
     unknown_layers: str | None = None,
+    map_path: str | None = None,
 ) -> IngestReport:
     """Ingest every source under ``paths`` into the dataset ``into`` (created if needed) with
     ``jobs`` local workers; ``on_outcome`` sees each source's outcome as it is committed;
-    ``unknown_layers`` is the labeller's choice for map layers a map does not publish."""
+    ``unknown_layers`` is the labeller's choice for map layers a map does not publish;
+    ``map_path`` the road map of traces without one (:mod:`scenegrep.readers.given_map`)."""
     UnknownLayers(unknown_layers)
+    if map_path is not None:
+        map_path = given_map_source(map_path).path
     root = Path(into).resolve()
     sources, bad = discover(paths)
     with Catalog(root, create=True) as catalog:
@@ -285,7 +296,7 @@ def ingest(
         for path, error in bad:
             catalog.record_source_error(path, error)
     _remove_stale_temporaries(root)
-    tasks = [IngestTask(s, str(root), known.get(s.path), label, unknown_layers) for s in sources]
+    tasks = [IngestTask(s, str(root), known.get(s.path), label, unknown_layers, map_path) for s in sources]
     report = IngestReport(failed=list(bad))
     results = run_all(ingest_source, tasks, jobs)
     batch: list[SourceOutcome] = []

@@ -1,5 +1,5 @@
 """Labelling inputs into a folder (``scenegrep label DATA... -o OUT``): every trace of an input is
-read, labelled on its own road map (or one fixed map for all), written as
+read, labelled on its road map (its own, else ``--map``'s: :mod:`scenegrep.readers.given_map`), written as
 ``OUT/<trace name>.parquet`` and counted in the per-class statistics.
 
 File names are the trace names made file-name safe (:func:`scenegrep.writers.file_names.file_stem`),
@@ -15,8 +15,8 @@ from pathlib import Path
 
 from .. import readers
 from ..errors import UserError, at
-from ..model import RoadMap
 from ..model.layers import UnknownLayers
+from ..readers.given_map import with_given_map
 from ..writers import write_trace_parquet
 from ..writers.file_names import file_stem
 from .config import LabelConfig
@@ -27,12 +27,13 @@ from .statistics import LabelStatistics
 @dataclass
 class FolderLabelling:
     """Labels inputs into the folder ``output`` with ``config`` (see the module docstring);
-    ``road_map`` for every trace (None: each trace's own), behaviours kept from
+    ``map_path`` the road map of traces without one (a trace with its own map and a ``map_path``
+    is an error), behaviours kept from
     ``min_confidence`` (None: the config's), the ``unknown_layers`` choice."""
 
     output: Path
     config: LabelConfig
-    road_map: RoadMap | None = None
+    map_path: str | None = None
     min_confidence: float | None = None
     unknown_layers: UnknownLayers | None = None
     statistics: LabelStatistics = field(default_factory=LabelStatistics)
@@ -48,7 +49,8 @@ class FolderLabelling:
         """Label and write every trace of the input at ``path``, calling ``on_trace`` after each;
         a labeller's error without a place is placed at ``path``."""
         for trace in readers.read_traces(path):
-            road_map = self.road_map or (readers.read_map(trace.map_source) if trace.map_source else None)
+            trace = with_given_map(trace, self.map_path)
+            road_map = readers.read_map(trace.map_source) if trace.map_source else None
             try:
                 labelled = label_trace(trace, road_map, self.config, self.min_confidence, self.unknown_layers).trace
             except UserError as exc:

@@ -47,7 +47,7 @@ def query_files(
     paths: list[str], spec: QuerySpec, map_path: str | None = None, on_rows: RowsCallback | None = None
 ) -> Results:
     """Run ``spec`` over every trace under ``paths``; ``map_path`` is the road map of traces
-    without their own (:mod:`scenegrep.readers.given_map`: a trace naming its own map fails with it). ``on_rows``
+    without their own (:func:`scenegrep.readers.with_given_map`: a trace naming its own map fails with it). ``on_rows``
     sees each trace's rows (a failed path's or source's row), with every column, as soon as they
     are ready. The results are ordered as a dataset run's, with its run id, and count the
     decisions the choice for unknown map layers affected, as a run's do."""
@@ -78,7 +78,7 @@ def read_queried_trace(
     source: str, trace_id: str, map_path: str | None = None, unknown_layers: str | None = None
 ) -> tuple[LabelTrace, RoadMap | None]:
     """The trace ``trace_id`` of a query over files and its road map (its own, else ``map_path``'s:
-    :mod:`scenegrep.readers.given_map`),
+    :func:`scenegrep.readers.with_given_map`),
     read from its ``source`` as the query read it, labelled under the query's choice for unknown
     map layers (UserError if the source no longer holds it)."""
     for number, trace in enumerate(readers.read_traces(source)):

@@ -55,7 +55,7 @@ class IngestTask:
     """What a worker needs to ingest one source: it, the dataset root, the checksum the
     catalog has for it (None if new), whether to label traces without behaviour labels, and the
     labeller's choice for map layers a map does not publish (see :mod:`scenegrep.model.layers`), and
-    the road map of traces without one (``--map``, :mod:`scenegrep.readers.given_map`)."""
+    the road map of traces without one (``--map``, :func:`scenegrep.readers.with_given_map`)."""
 
     source: Source
     root: str
@@ -211,11 +211,11 @@ def prepare_trace(
     trace: LabelTrace, label: bool, unknown_layers: UnknownLayers | None = None, map_path: str | None = None
 ) -> tuple[LabelTrace, RoadMap | None]:
     """A trace as a dataset holds it, and its road map (None when it has none): its own, or
-    ``map_path`` (``--map``) when it names none (:mod:`scenegrep.readers.given_map`: a trace naming its own map and
-    a ``map_path`` is a UserError); when ``label`` and it has no behaviour labels, labelled with that
-    map by ``scenegrep label``'s labeller, under the choice ``unknown_layers`` for map layers the
+    ``map_path`` (``--map``) when it names none (:func:`scenegrep.readers.with_given_map`: a
+    trace naming its own map and a ``map_path`` is a UserError); when ``label`` and it has no
+    behaviour labels, labelled with that map by ``scenegrep label``'s labeller, under the choice ``unknown_layers`` for map layers the
     map does not publish. Ingest and a query over files both read traces this way."""
-    trace = with_given_map(trace, map_path)
+    trace = readers.with_given_map(trace, map_path)
     road_map = None if trace.map_source is None else readers.read_map(trace.map_source)
     if label:
         trace = labelled(trace, road_map, unknown_layers)
@@ -285,10 +285,10 @@ def ingest(
     """Ingest every source under ``paths`` into the dataset ``into`` (created if needed) with
     ``jobs`` local workers; ``on_outcome`` sees each source's outcome as it is committed;
     ``unknown_layers`` is the labeller's choice for map layers a map does not publish;
-    ``map_path`` the road map of traces without one (:mod:`scenegrep.readers.given_map`)."""
+    ``map_path`` the road map of traces without one (:func:`scenegrep.readers.with_given_map`)."""
     UnknownLayers(unknown_layers)
     if map_path is not None:
-        map_path = given_map_source(map_path).path
+        map_path = readers.given_map_source(map_path).path
     root = Path(into).resolve()
     sources, bad = discover(paths)
     with Catalog(root, create=True) as catalog:

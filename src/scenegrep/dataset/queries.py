@@ -395,16 +395,15 @@ def _query_task(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> l
 def _task_rows(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> list[dict[str, Any]]:
     """One ingested trace's rows; a scenario query reads its labels under the query's choice for
     unknown map layers, labelled on its map as a query over files labels it (:func:`.labelling.labelled`);
-    its map is its own, else ``fallback_map`` (:mod:`scenegrep.readers.given_map`)."""
+    its map is its own, else ``fallback_map`` (:func:`scenegrep.readers.with_given_map`)."""
     from .. import readers
-    from ..readers.given_map import conflict
     from .labelling import labelled
 
     trace = readers.read_trace(task.file, "scenegrep-parquet")
     if not uses_map(spec):
         return match_trace(spec, trace, None)
     if task.map_file and fallback_map:
-        raise conflict(task.name, task.map_file)
+        raise readers.map_conflict(task.name, task.map_file)
     road_map = readers.read_map(task.map_file or fallback_map) if task.map_file or fallback_map else None
     if spec.kind == "scenario":
         trace = labelled(trace, road_map, spec_choice(spec), task.labelled_under)

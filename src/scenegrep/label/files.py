@@ -1,5 +1,5 @@
 """Labelling inputs into a folder (``scenegrep label DATA... -o OUT``): every trace of an input is
-read, labelled on its road map (its own, else ``--map``'s: :mod:`scenegrep.readers.given_map`), written as
+read, labelled on its road map (its own, else ``--map``'s: :func:`scenegrep.readers.with_given_map`), written as
 ``OUT/<trace name>.parquet`` and counted in the per-class statistics.
 
 File names are the trace names made file-name safe (:func:`scenegrep.writers.file_names.file_stem`),
@@ -16,7 +16,6 @@ from pathlib import Path
 from .. import readers
 from ..errors import UserError, at
 from ..model.layers import UnknownLayers
-from ..readers.given_map import with_given_map
 from ..writers import write_trace_parquet
 from ..writers.file_names import file_stem
 from .config import LabelConfig
@@ -49,7 +48,7 @@ class FolderLabelling:
         """Label and write every trace of the input at ``path``, calling ``on_trace`` after each;
         a labeller's error without a place is placed at ``path``."""
         for trace in readers.read_traces(path):
-            trace = with_given_map(trace, self.map_path)
+            trace = readers.with_given_map(trace, self.map_path)
             road_map = readers.read_map(trace.map_source) if trace.map_source else None
             try:
                 labelled = label_trace(trace, road_map, self.config, self.min_confidence, self.unknown_layers).trace

@@ -21,7 +21,7 @@ name). Sub-folders are not entered.
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
@@ -224,3 +224,31 @@ def read_map(source: MapSource | str | Path, format_name: str | None = None) -> 
     name = _checked(path, source.format if isinstance(source, MapSource) else format_name, "map")
     regular_file(path, f"a road map ({name})")
     return _read_map_cached(path, name, key)
+
+
+def given_map_source(path: str) -> MapSource:
+    """``--map MAP`` as a map source: a file of a map format (UserError otherwise), named by its
+    absolute path, so a dataset that ingested it reads it from anywhere."""
+    name = _checked(path, None, "map")
+    regular_file(path, f"a road map ({name})")
+    return MapSource(str(Path(path).resolve()), name)
+
+
+def map_conflict(name: str, own_map: str) -> UserError:
+    """The error of a trace ``name`` that has its own map ``own_map`` and is given a ``--map``."""
+    return UserError(
+        f"trace {name!r} has its own road map ({Path(own_map).name}) and --map gives another; "
+        "--map is for traces without a map: leave it out for this trace"
+    )
+
+
+def with_given_map(trace: LabelTrace, map_path: str | None) -> LabelTrace:
+    """``trace`` with the map ``map_path`` (``--map``) when it names none; unchanged without
+    ``map_path``. One rule in ``ingest``, ``label`` and the query commands: a trace that names its
+    own map and is given a ``map_path`` is a UserError for that trace (:func:`map_conflict`),
+    never a silent choice of one of the two maps; which map is meant is the user's to say."""
+    if map_path is None:
+        return trace
+    if trace.map_source is not None:
+        raise map_conflict(trace.name, trace.map_source.path)
+    return replace(trace, map_source=given_map_source(map_path))

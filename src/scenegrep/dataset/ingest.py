@@ -213,8 +213,9 @@ def prepare_trace(
     """A trace as a dataset holds it, and its road map (None when it has none): its own, or
     ``map_path`` (``--map``) when it names none (:func:`scenegrep.readers.with_given_map`: a
     trace naming its own map and a ``map_path`` is a UserError); when ``label`` and it has no
-    behaviour labels, labelled with that map by ``scenegrep label``'s labeller, under the choice ``unknown_layers`` for map layers the
-    map does not publish. Ingest and a query over files both read traces this way."""
+    behaviour labels, labelled with that map by ``scenegrep label``'s labeller, under the choice
+    ``unknown_layers`` for map layers the map does not publish. Ingest and a query over files both
+    read traces this way."""
     trace = readers.with_given_map(trace, map_path)
     road_map = None if trace.map_source is None else readers.read_map(trace.map_source)
     if label:

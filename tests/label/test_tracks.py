@@ -12,6 +12,8 @@ from scenegrep.label.tracks import Tracks
 from scenegrep.model import LabelTrace, ObjectTable, StateTable
 from scenegrep.model.geometry import normalize_angle
 
+TAU = 2 * math.pi
+
 
 @st.composite
 def traces(draw):
@@ -58,20 +60,54 @@ def test_windows_gradients_and_unwrapping_stay_inside_segments(trace, half):
     heading = trace.states.heading[tracks.order]
     position = {row: p for p, row in enumerate(tracks.order.tolist())}
     mean, slope = tracks.window_mean(x, half), tracks.gradient(x)
-    unwrapped = tracks.unwrap(heading)
+    turns = tracks.turns(heading)
+    smoothed, yaw_rate = tracks.angle_mean(heading, turns, half), tracks.gradient(heading, turns)
     for rows in segments(trace, 1.0):
         ps = [position[r] for r in rows]
         times = [trace.frame_time[trace.states.frame[r]] for r in rows]
+        unwrapped = np.unwrap(heading[ps])  # brute force: steps of at most pi, from the first heading
         for j, p in enumerate(ps):
             window = ps[max(0, j - half) : j + half + 1]
             assert math.isclose(mean[p], np.mean(x[window]), abs_tol=1e-9)
-            a, b = ps[max(j - 1, 0)], ps[min(j + 1, len(ps) - 1)]
-            dt = times[min(j + 1, len(ps) - 1)] - times[max(j - 1, 0)]
-            expected = (x[b] - x[a]) / dt if dt > 0 else np.nan
+            a, b = max(j - 1, 0), min(j + 1, len(ps) - 1)
+            dt = times[b] - times[a]
+            expected = (x[ps[b]] - x[ps[a]]) / dt if dt > 0 else np.nan
             assert np.isclose(slope[p], expected, equal_nan=True)
-            assert math.isclose(normalize_angle(unwrapped[p] - heading[p]), 0.0, abs_tol=1e-9)
-            if j:
-                assert abs(unwrapped[p] - unwrapped[ps[j - 1]]) <= math.pi + 1e-9
+            assert np.isclose(yaw_rate[p], (unwrapped[b] - unwrapped[a]) / dt if dt > 0 else np.nan, equal_nan=True)
+            base = heading[p] + TAU * (turns[p] - turns[ps[0]])  # heading p unwrapped from the first
+            assert math.isclose(base, unwrapped[j], abs_tol=1e-9)
+            window_unwrapped = unwrapped[max(0, j - half) : j + half + 1]
+            assert math.isclose(smoothed[p] - heading[p] + base, np.mean(window_unwrapped), abs_tol=1e-9)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    values=st.lists(st.floats(-1e3, 1e3), min_size=2, max_size=30),
+    angles=st.lists(st.floats(-7, 7), min_size=2, max_size=30),
+    earlier=st.lists(st.floats(-1e3, 1e3), max_size=30),
+    half=st.integers(1, 6),
+)
+def test_window_values_do_not_depend_on_earlier_observations(values, angles, earlier, half):
+    """One object's track with or without earlier observations of it: every value whose window
+    lies in the shorter track is bit for bit the same (no running sum over the segment)."""
+    n = min(len(values), len(angles))
+    values, angles = np.array(values[:n]), normalize_angle(np.array(angles[:n]))
+    k = len(earlier)
+
+    times = np.arange(k + n) * 0.1
+
+    def of(xs, hs):
+        m = len(xs)
+        states = StateTable.build(np.arange(m), np.zeros(m, int), xs, xs, hs)
+        trace = LabelTrace.build("t", np.arange(m), times[-m:], ObjectTable.build(["o"], ["car"]), states)
+        tracks = Tracks.of(trace, max_gap_s=1.0, interval=0.1)
+        turns = tracks.turns(hs)
+        return tracks.window_mean(xs, half), tracks.angle_mean(hs, turns, half), tracks.gradient(hs, turns)
+
+    short = of(values, angles)
+    long = of(np.r_[earlier, values], np.r_[normalize_angle(np.array(earlier)), angles])
+    for got, expected in zip(short, long, strict=True):
+        assert np.array_equal(got[half:], expected[k + half :], equal_nan=True)
 
 
 @settings(max_examples=150, deadline=None)

@@ -94,3 +94,27 @@ def test_online_reports_the_windows_of_the_offline_query(files, capsys, monkeypa
     code, online, _ = run([FIG1, "--online", "--window", "3", "--map", files / "map.parquet", "--all"], capsys)
     assert code == 0 and len(online) == 3
     assert [line.split(":", 1)[1] for line in online] == [line.rsplit(":", 1)[1] for line in offline]
+
+
+@pytest.mark.real_data
+def test_online_counts_the_unknown_layer_decisions_of_the_offline_labeller(real_data, capsys, monkeypatch):
+    """nuScenes scene-0061 (its map publishes no crosswalks), 40 unlabelled frames in chunks of 10:
+    the decisions the permissive choice affected, on stderr, are the offline labeller's (each
+    observation once, though the online labeller relabels its kept history at every chunk)."""
+    from dataclasses import replace
+
+    from scenegrep import readers
+    from scenegrep.label import label_trace
+    from scenegrep.model.layers import UnknownLayers
+
+    trace = readers.read_trace(real_data / "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl")
+    trace = replace(trace.slice_frames(0, 40), behaviours=None)
+    offline = UnknownLayers("permissive")
+    label_trace(trace, readers.read_map(trace.map_source), unknown_layers=offline)
+    assert offline.decisions["crossing"] > 0
+    lines = [json.dumps(trace_document(trace.slice_frames(k, k + 10))) for k in range(0, 40, 10)]
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO("\n".join(lines).encode())))
+    query = "examples/queries/real/stationary_vehicle.scenic"
+    args = [query, "--online", "--window", "10", "--map", trace.map_source.path, "--unknown-layers", "permissive"]
+    _, _, err = run(args, capsys)
+    assert f"scenegrep: {offline.report()}" in err

@@ -3,9 +3,12 @@ road map, per observation, in track order (:class:`~.tracks.Tracks`).
 
 Kinematics (smoothed over ``[tracks].smooth_s``): ``speed`` (m/s), ``along`` (speed along the
 object's own heading, negative when reversing), ``accel`` (m/s², derivative of the smoothed
-speed), ``heading`` (the box heading unwrapped along the track and smoothed, radians),
-``yaw_rate`` (rad/s, left positive), ``motion_heading`` (direction of the smoothed velocity). Velocities are the
-trace's own where given, else finite differences of positions.
+speed), ``heading`` (the box heading smoothed along the track, radians, less whole turns: the
+track's unwrapped smoothed heading is ``heading + 2π·turns``, ``turns`` an integer per
+observation, :meth:`~.tracks.Tracks.turns`), ``yaw_rate`` (rad/s, left positive),
+``motion_heading`` (direction of the smoothed velocity). Velocities are the trace's own where
+given, else finite differences of positions. Every value reads only the observations of its
+windows (:mod:`.tracks`), so a bounded history gives the offline values bit for bit.
 
 Map relations (all absent, i.e. -1/NaN/False, without a map): ``lane`` (index of the map lane
 the object is in, the best-aligned where lanes overlap), ``lane_heading`` (that lane's direction
@@ -39,6 +42,7 @@ class Evidence:
     along: np.ndarray
     accel: np.ndarray
     heading: np.ndarray
+    turns: np.ndarray
     yaw_rate: np.ndarray
     motion_heading: np.ndarray
     lane: np.ndarray
@@ -63,7 +67,9 @@ def gather(trace: LabelTrace, road_map: RoadMap | None, tracks: Tracks, smooth_s
     vx, vy = _velocity(trace)
     vx, vy = tracks.window_mean(vx[order], half), tracks.window_mean(vy[order], half)
     x, y = states.x[order], states.y[order]
-    heading = tracks.window_mean(tracks.unwrap(states.heading[order]), half)
+    raw = states.heading[order]
+    turns = tracks.turns(raw)
+    heading = tracks.angle_mean(raw, turns, half)
     speed = np.hypot(vx, vy)
     along = -np.sin(heading) * vx + np.cos(heading) * vy
     accel = tracks.window_mean(tracks.gradient(speed), half)
@@ -80,7 +86,8 @@ def gather(trace: LabelTrace, road_map: RoadMap | None, tracks: Tracks, smooth_s
         along=along,
         accel=accel,
         heading=heading,
-        yaw_rate=tracks.window_mean(tracks.gradient(heading), half),
+        turns=turns,
+        yaw_rate=tracks.window_mean(tracks.gradient(heading, turns), half),
         motion_heading=heading_of_vector(vx, vy),
         lane=relations.lane,
         lane_heading=relations.lane_heading,

@@ -6,6 +6,11 @@ least the minimum confidence (seed 000's thresholding of a behaviour predictor);
 empty: when no behaviour reaches the minimum, the most confident one is kept. The labelled trace
 keeps everything of the input but its behaviour labels (replaced, with their confidences) and
 fills the lane of observations that had none with the map lane the labeller found.
+
+:func:`label_trace` also makes the user's choice for an unknown crosswalk layer (an error
+without one, else its decisions counted, :func:`.rules.decide_crossings`);
+:func:`label_deferred` leaves that to its caller, with the observations concerned
+(:attr:`Labelling.crossing_depends`): the online labeller decides for the frames it hands out.
 """
 
 from __future__ import annotations
@@ -18,21 +23,25 @@ from ..model import BehaviourLabels, LabelTrace, RoadMap
 from ..model.layers import UnknownLayers
 from .config import LabelConfig, load_config
 from .evidence import Evidence, gather
-from .rules import VOCABULARY, confidences
+from .rules import VOCABULARY, confidences, decide_crossings
 from .tracks import Tracks
 
-LABELLER_VERSION = 2
+LABELLER_VERSION = 3
 """Bumped whenever the labels of some input change, so that labels of an older labeller are not
 reused (an ingested dataset labels its sources again). 2: lane-change sides are the vehicle's own
-(swapped where it faces against its lane)."""
+(swapped where it faces against its lane). 3: window sums and headings are local to their windows
+(:mod:`.tracks`), which can tip a value within rounding of a threshold (the same labels on the
+real traces of ../shared/real_data)."""
 
 
 @dataclass(frozen=True)
 class Labelling:
-    """A labelled trace and, per state row, whether the object is in an intersection."""
+    """A labelled trace and, per state row, whether the object is in an intersection and whether
+    its Cross confidence depends on an unknown crosswalk layer (:func:`.rules.confidences`)."""
 
     trace: LabelTrace
     in_intersection: np.ndarray
+    crossing_depends: np.ndarray
     evidence: Evidence
     tracks: Tracks
 
@@ -49,12 +58,30 @@ def label_trace(
     ``unknown_layers`` is the user's choice for map layers the map does not publish (see
     :mod:`.rules`: the crosswalks of the Cross rule); ``interval`` (s) pins the observation interval
     the windows are counted in (default: the median of the trace's, :class:`~.tracks.Tracks`)."""
+    choice = unknown_layers or UnknownLayers()
+    labelling = label_deferred(trace, road_map, config, min_confidence, choice, interval)
+    decide_crossings(choice, labelling.crossing_depends, labelling.evidence.map_name)
+    return labelling
+
+
+def label_deferred(
+    trace: LabelTrace,
+    road_map: RoadMap | None = None,
+    config: LabelConfig | None = None,
+    min_confidence: float | None = None,
+    unknown_layers: UnknownLayers | None = None,
+    interval: float | None = None,
+) -> Labelling:
+    """:func:`label_trace` without the choice's decision: the observations whose Cross confidence
+    the choice's assumption decided are :attr:`Labelling.crossing_depends`, neither counted nor
+    refused (the caller does, :func:`.rules.decide_crossings`, for the rows it hands out)."""
     config = config or load_config()
     threshold = config.labels.min_confidence if min_confidence is None else min_confidence
     tracks = Tracks.of(trace, config.tracks.max_gap_s, interval)
     evidence = gather(trace, road_map, tracks, config.tracks.smooth_s)
     kinds = trace.objects.kinds()[trace.states.object[tracks.order]]
-    scores = confidences(evidence, kinds, tracks, config, unknown_layers)
+    everywhere = unknown_layers is not None and unknown_layers.everywhere
+    scores, depends = confidences(evidence, kinds, tracks, config, everywhere)
     member = scores >= max(threshold, np.finfo(float).tiny)
     best = np.argmax(scores, axis=1)
     member[np.arange(len(best)), best] |= ~member.any(axis=1)
@@ -64,7 +91,8 @@ def label_trace(
         tracks.to_rows(np.where(member, scores, np.nan).astype(np.float32)),
     )
     labelled = replace(trace, behaviours=labels, **_with_lanes(trace, road_map, tracks.to_rows(evidence.lane)))
-    return Labelling(labelled, tracks.to_rows(evidence.in_intersection), evidence, tracks)
+    rows = tracks.to_rows
+    return Labelling(labelled, rows(evidence.in_intersection), rows(depends), evidence, tracks)
 
 
 def _with_lanes(trace: LabelTrace, road_map: RoadMap | None, lane: np.ndarray) -> dict:

@@ -21,22 +21,28 @@ seconds). The added latency is ``H`` observations of a track: ``H`` frames when 
 observed every frame (3.5 s at 10 Hz with the shipped thresholds and a map with intersections),
 at most ``H * max_gap_s`` seconds.
 
+The user's choice for an unknown crosswalk layer (:mod:`.rules`) is made for the observations of
+the frames handed out, once each: the decisions it affected are counted as offline (the kept
+history is relabelled at every chunk, but not counted again), and without a choice the error is
+raised when the first frame that needs it is handed out.
+
 Two inputs of the offline labeller are whole-trace, and are declared, not hidden:
 
 * the observation interval the windows are counted in is the median step of the whole trace;
-  online it is pinned to the median of the first frames that have one, and :attr:`OnlineLabeller.
-  warnings` says so whenever a later history's median would count a window differently (the
-  labels can then differ from offline);
+  online it is pinned to the median of the first frames that have one (:func:`windows` counts
+  the windows in it), and :attr:`OnlineLabeller.warnings` says so whenever a later history's
+  median would count some window differently (the labels can then differ from offline; this
+  relies on the whole trace's median counting the windows as some kept history's median does);
 * a lane-id change after an off-lane stretch reads the last lane before it (a forward fill over
   the segment); a stretch longer than the kept history loses it, which is declared likewise.
 
-Equality is that of the label sets and of the confidences up to floating-point rounding (the
-running sums of the windows and the heading unwrap start at the kept history's first
-observation instead of the trace's). A quantity within rounding of a decision boundary can
-still tip the other way, undeclared: a confidence at the minimum confidence, or a heading
-exactly perpendicular to its lane (the sign of their cosine decides the lane-change side; the
-property test in tests/label/test_online.py finds such ties with ``--hypothesis-seed=6`` and 500
-examples). Real headings are never exactly perpendicular; a fix would make the window sums local.
+Equality is exact otherwise: every value of the labeller at an observation reads only the
+observations of its windows, summed in an order fixed by the window, and headings are never
+unwrapped into running sums (:mod:`.tracks`), so an observation handed out gets the offline
+confidences bit for bit and the offline label set, ties at the thresholds included (a confidence
+exactly at the minimum, a speed at a ramp's end, a heading exactly perpendicular to its lane).
+The property test in tests/label/test_online.py checks it on random traces that move exactly on
+those boundaries.
 """
 
 from __future__ import annotations
@@ -48,23 +54,29 @@ import numpy as np
 from ..model import LabelTrace, RoadMap, concatenate
 from ..model.layers import UnknownLayers
 from .config import LabelConfig, load_config
-from .labeller import label_trace
+from .labeller import label_deferred
+from .rules import decide_crossings
 from .tracks import Tracks
+
+
+def windows(config: LabelConfig, tracks: Tracks, knows_intersections: bool = True) -> tuple[int, ...]:
+    """The window lengths (positions) the labeller reads at ``tracks.interval``: the smoothing's
+    half window, the lane-change window, the turn's half window and, on a map with
+    intersections (``knows_intersections``), the turn's intersection margin."""
+    vehicle = config.vehicle
+    lengths = (
+        max(1, tracks.frames(config.tracks.smooth_s) // 2),
+        max(1, tracks.frames(vehicle.lane_change_event_s)),
+        max(1, tracks.frames(vehicle.turn_window_s) // 2),
+    )
+    return (*lengths, max(1, tracks.frames(vehicle.turn_intersection_margin_s))) if knows_intersections else lengths
 
 
 def reach(config: LabelConfig, tracks: Tracks, knows_intersections: bool = True) -> int:
     """``H`` (= ``B``): positions of a segment the labels at one observation read on either side
     (see the module docstring); ``knows_intersections`` adds the turn's intersection margin."""
-    vehicle = config.vehicle
-    half = max(1, tracks.frames(config.tracks.smooth_s) // 2)
-    spans = [
-        2 * half + 2,
-        half + 1 + max(1, tracks.frames(vehicle.lane_change_event_s)),
-        half + max(1, tracks.frames(vehicle.turn_window_s) // 2),
-    ]
-    if knows_intersections:
-        spans.append(half + max(1, tracks.frames(vehicle.turn_intersection_margin_s)))
-    return max(spans)
+    half, *others = windows(config, tracks, knows_intersections)
+    return max(2 * half + 2, half + 1 + others[0], *(half + other for other in others[1:]))
 
 
 @dataclass
@@ -108,14 +120,13 @@ class OnlineLabeller:
         own = Tracks.of(trace, gap)
         if self.interval is None and len(own) > len(np.unique(own.start)):
             self.interval = own.interval
-        labelling = label_trace(
-            trace, self.road_map, self.config, self.min_confidence, self.unknown_layers, self.interval
-        )
+        choice = self.unknown_layers or UnknownLayers()
+        labelling = label_deferred(trace, self.road_map, self.config, self.min_confidence, choice, self.interval)
         tracks = labelling.tracks
         depth = reach(self.config, tracks, labelling.evidence.knows_intersections)
         if self.interval is not None:
             self.depth = depth
-        self._check_interval(own, tracks, depth, labelling.evidence.knows_intersections)
+        self._check_interval(own, tracks, labelling.evidence.knows_intersections)
         frame = trace.states.frame[tracks.order]
         position = np.arange(len(tracks))
         if ended:
@@ -130,6 +141,8 @@ class OnlineLabeller:
         waiting = np.bincount(frame[~final], minlength=trace.n_frames) > 0
         stop = int(np.argmax(waiting)) if waiting.any() else trace.n_frames
         out = labelling.trace.slice_frames(self.done, stop) if stop > self.done else None
+        handed = (trace.states.frame >= self.done) & (trace.states.frame < stop)
+        decide_crossings(choice, labelling.crossing_depends[handed], labelling.evidence.map_name)
         begin = stop
         pending = frame >= stop
         if pending.any():
@@ -140,9 +153,11 @@ class OnlineLabeller:
         self.done = stop - begin
         return out
 
-    def _check_interval(self, own: Tracks, tracks: Tracks, depth: int, knows: bool) -> None:
+    def _check_interval(self, own: Tracks, tracks: Tracks, knows: bool) -> None:
         """Declare a history whose own median interval would count the windows differently."""
-        if len(own) == len(np.unique(own.start)) or reach(self.config, own, knows) == depth:
+        if len(own) == len(np.unique(own.start)) or windows(self.config, own, knows) == windows(
+            self.config, tracks, knows
+        ):
             return
         message = (
             f"online labels: the observation interval changed from {tracks.interval:.3f} s to "

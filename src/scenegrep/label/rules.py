@@ -21,7 +21,9 @@ Every confidence is a product of ramps (:data:`~.config.Ramp`) over the evidence
   ``Cross`` confidence depends on whether it is in one (walking, not fully crossing by the lane
   evidence) is an error unless the user chose how to treat the unknown layer
   (:class:`~scenegrep.model.layers.UnknownLayers`: in a crosswalk everywhere, or nowhere); those
-  observations are counted as decisions the choice affected.
+  observations are counted as decisions the choice affected. :func:`confidences` returns them as
+  a mask; :func:`decide_crossings` raises or counts for the observations a caller hands out (the
+  online labeller scores a history many times but counts each observation once).
 * anything else (static objects): ``Stationary`` by the vehicle speed ramp.
 
 A track with no usable speed (a single observation) gets ``[tracks].unknown_confidence`` for
@@ -77,10 +79,11 @@ def ramp(values: np.ndarray, bounds: Ramp) -> np.ndarray:
 
 
 def confidences(
-    evidence: Evidence, kinds: np.ndarray, tracks: Tracks, config: LabelConfig, choice: UnknownLayers | None = None
-) -> np.ndarray:
-    """(observations, len(VOCABULARY)) confidences in track order; ``kinds`` per observation;
-    ``choice`` treats an unknown crosswalk layer (None: an error where a decision needs it)."""
+    evidence: Evidence, kinds: np.ndarray, tracks: Tracks, config: LabelConfig, everywhere: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
+    """(observations, len(VOCABULARY)) confidences in track order, ``kinds`` per observation, and
+    per observation whether its Cross confidence depends on an unknown crosswalk layer (taken to
+    be ``everywhere``, else nowhere; :func:`decide_crossings` makes that a decision or an error)."""
     out = np.zeros((len(kinds), len(VOCABULARY)))
     column = {name: k for k, name in enumerate(VOCABULARY)}
     vehicle = np.isin(kinds, list(VEHICLE_KINDS))
@@ -89,12 +92,22 @@ def confidences(
     for name, score in _vehicle(evidence, tracks, config.vehicle, unknown).items():
         out[vehicle, column[name]] = score[vehicle]
     walks = _walking(evidence, config.pedestrian, unknown)
-    walks["Cross"] = _cross(evidence, walks, walking, config.pedestrian, choice or UnknownLayers())
+    walks["Cross"], depends = _cross(evidence, walks, walking, config.pedestrian, everywhere)
     for name, score in walks.items():
         out[walking, column[name]] = score[walking]
     other = ~(vehicle | walking)
     out[other, column["Stationary"]] = _stationary(evidence.speed, config.vehicle.stationary_speed_mps, unknown)[other]
-    return out
+    return out, depends
+
+
+def decide_crossings(choice: UnknownLayers, depends: np.ndarray, map_name: str | None) -> None:
+    """The user's choice for the observations whose Cross confidence depends on the unknown crosswalk
+    layer (``depends``, see :func:`confidences`): an error without a choice, else counted."""
+    n = int(np.count_nonzero(depends))
+    if n and choice.mode is None:
+        needed_by = f"the labeller's Cross rule ({n} observations of walking objects)"
+        raise choice.refuse(["crossing"], needed_by, map_name or "?")
+    choice.count("crossing", n)
 
 
 def _stationary(speed: np.ndarray, bounds: Ramp, unknown: float) -> np.ndarray:
@@ -148,7 +161,7 @@ def _turn_angle(e: Evidence, tracks: Tracks, c: VehicleConfig) -> np.ndarray:
     position = np.arange(len(tracks))
     later = np.minimum(position + half, tracks.end - 1)
     earlier = np.maximum(position - half, tracks.start)
-    change = e.heading[later] - e.heading[earlier]
+    change = tracks.angle_change(e.heading, e.turns, later, earlier)
     if not e.knows_intersections:
         return change
     near = tracks.window_any(e.in_intersection, max(1, tracks.frames(c.turn_intersection_margin_s)))
@@ -168,17 +181,13 @@ def _on_road_cross(e: Evidence, c: PedestrianConfig) -> np.ndarray:
 
 
 def _cross(
-    e: Evidence, walks: dict[str, np.ndarray], walking: np.ndarray, c: PedestrianConfig, choice: UnknownLayers
-) -> np.ndarray:
-    """The Cross confidence: walking, in a crosswalk or crossing by the lane evidence. Where the
-    crosswalk layer is unknown, the observations of walking objects whose confidence depends on it
-    take the user's choice (counted), or are an error without one."""
+    e: Evidence, walks: dict[str, np.ndarray], walking: np.ndarray, c: PedestrianConfig, everywhere: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """The Cross confidence: walking, in a crosswalk or crossing by the lane evidence, an unknown
+    crosswalk layer taken to be ``everywhere`` (else nowhere); and where that assumption decides it
+    (observations of walking objects, walking, not fully crossing by the lane evidence)."""
     walk, on_road = walks["Walk"], _on_road_cross(e, c)
     unknown = np.isnan(e.in_crossing)
     depends = unknown & walking & (walk > 0) & (on_road < 1)
-    if depends.any() and choice.mode is None:
-        needed_by = f"the labeller's Cross rule ({int(depends.sum())} observations of walking objects)"
-        raise choice.refuse(["crossing"], needed_by, e.map_name or "?")
-    choice.count("crossing", int(depends.sum()))
-    in_crossing = np.where(unknown, 1.0 if choice.everywhere else 0.0, e.in_crossing)
-    return walk * np.maximum(in_crossing, on_road)
+    in_crossing = np.where(unknown, 1.0 if everywhere else 0.0, e.in_crossing)
+    return walk * np.maximum(in_crossing, on_road), depends

@@ -29,7 +29,7 @@ SRC = Path(__file__).resolve().parents[1] / "src"
 PACKAGE = "scenegrep"
 
 LAYERS: tuple[tuple[str, ...], ...] = (
-    ("errors", "cache", "lazy", "progress", "json_lines"),  # foundations: import nothing of scenegrep
+    ("errors", "cache", "lazy", "progress", "json_lines", "wording"),  # foundations: import nothing of scenegrep
     ("model", "terminal"),  # the data model (label traces, road maps); text safe for terminals
     ("writers",),  # the model to files
     ("readers",),  # files to the model (converted maps are cached through the writers)

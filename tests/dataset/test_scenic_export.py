@@ -261,7 +261,7 @@ def test_failed_traces_and_interrupted_runs_are_said_not_silently_skipped(target
     Results(results_table([row, failed]), "run", "interrupted").write_parquet(results)
     code, err = run(["export", results, target, tmp_path / "out"], capsys)
     assert code == 0 and "1 matches written" in err, err
-    assert "1 traces failed" in err and "none exported" in err and "an interrupted run" in err
+    assert "1 trace failed" in err and "none exported" in err and "an interrupted run" in err
     assert len(list((tmp_path / "out").iterdir())) == 1
 
 

@@ -32,7 +32,7 @@ def test_writes_labelled_traces_and_prints_statistics(tmp_path, capsys):
     assert code == 0
     labelled = read_trace(folder / "out" / "hand.parquet")
     assert set(labelled.behaviours.sets()) == {frozenset({"FollowLane"}), frozenset({"Stationary"})}
-    assert "car: 1 objects, 61 obs, 1.00  FollowLane 100.0" in out
+    assert "car: 1 object, 61 obs, 1.00  FollowLane 100.0" in out
     assert labelled.lane_names()[0] == "n1"
 
 

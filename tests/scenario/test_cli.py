@@ -37,7 +37,7 @@ def test_match_line_names_window_and_correspondence(files, capsys):
     code, lines, err = run([FIG1, files / "table2.json", "--window", "5", "--map", files / "map.parquet"], capsys)
     assert code == 0
     assert lines == ["table2:0-4  ego=car2  otherCar=car1"]
-    assert err == ["scenegrep: 1 of 1 traces match, 0 pruned, 0 failed"]
+    assert err == ["scenegrep: 1 of 1 trace matches, 0 pruned, 0 failed"]
 
 
 def test_no_match_exits_1_and_explains(files, capsys):

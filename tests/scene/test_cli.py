@@ -43,7 +43,7 @@ def test_text_output_names_correspondence_and_values(files, capsys):
     assert code == 0 and len(lines) == 1
     assert lines[0].startswith("hand:0-0  ego=ego  other=c  |  ")
     assert "Range(4, 10)@3:33=6" in lines[0]  # a 6 m gap
-    assert err == ["scenegrep: 1 of 1 traces match, 0 pruned, 0 failed"]
+    assert err == ["scenegrep: 1 of 1 trace matches, 0 pruned, 0 failed"]
 
 
 def test_json_output_and_explain(files, capsys):

@@ -93,7 +93,7 @@ def test_misses_are_kept_nearest_first_and_traces_past_the_limit_counted():
     for dx in (0.5, 0.1, 0.3, 0.01):
         misses.add(AT.match(trace_of({"ego": ("Car", 2 + dx, 30, 0.3)}), MAP, SceneOptions()), source=f"dx={dx}")
     assert [m.source for m in misses.found] == ["dx=0.1", "dx=0.3"]
-    assert "3 trace(s)" in misses.summary() and "1 more trace(s) not examined" in misses.summary()
+    assert "3 traces" in misses.summary() and "1 more trace not examined" in misses.summary()
 
 
 def test_a_trace_where_the_scene_holds_is_counted_not_searched():

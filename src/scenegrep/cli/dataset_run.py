@@ -18,12 +18,13 @@ import argparse
 import json
 import sys
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from functools import partial
 from pathlib import Path
 from typing import Any
 
 from .inputs import is_one_input
+from ..wording import counted, verb
 from .exit_codes import EXIT_INTERRUPTED, EXIT_NO_MATCH, EXIT_SOME_FAILED
 from .options import reject_dataset_only, report_unknown_layers, run_options_of
 
@@ -46,7 +47,11 @@ def run_query_command(
         results.write_parquet(args.output)
     counts = results.counts()
     if not args.quiet:
+        if not args.dataset:  # a dataset run said so before querying (_report_plan)
+            _report_pruned(reason for reason in results.with_status("pruned")["explanation"].to_pylist())
         _summary(results, where or (f"; results in {args.output}" if args.output else ""))
+        for warning in results.warnings:
+            print(f"scenegrep: warning: {warning}", file=sys.stderr)
     if uses_map(spec):
         report_unknown_layers(UnknownLayers(spec.option("unknown_layers"), Counter(results.assumed)))
         if not counts["matched"]:
@@ -229,8 +234,13 @@ def _file_trace(rows: list[dict[str, Any]], args: argparse.Namespace, trace_id: 
 
 def _report_plan(plan: Any) -> None:
     total = len(plan.kept) + len(plan.pruned)
-    print(f"scenegrep: querying {len(plan.kept)} of {total} traces", file=sys.stderr)
-    for reason, count in Counter(_general(r) for _, r in plan.pruned).most_common():
+    print(f"scenegrep: querying {len(plan.kept)} of {counted(total, 'trace')}", file=sys.stderr)
+    _report_pruned(reason for _, reason in plan.pruned)
+
+
+def _report_pruned(reasons: Iterable[str]) -> None:
+    """One line per pruning reason: how many traces the planner pruned for it."""
+    for reason, count in Counter(_general(r) for r in reasons).most_common():
         print(f"scenegrep: pruned {count}: {reason}", file=sys.stderr)
 
 
@@ -242,7 +252,8 @@ def _general(reason: str) -> str:
 def _summary(results: Any, where: str) -> None:
     counts = results.counts()
     print(
-        f"scenegrep: {counts['matched']} of {counts['traces']} traces match, {counts['pruned']} pruned, "
+        f"scenegrep: {counts['matched']} of {counted(counts['traces'], 'trace')} {verb(counts['matched'], 'match')}, "
+        f"{counts['pruned']} pruned, "
         f"{counts['failed']} failed{where}",
         file=sys.stderr,
     )

@@ -16,6 +16,7 @@ import sys
 from typing import Any
 
 from ..errors import UserError
+from ..wording import counted, verb
 
 
 def add_parser(subparsers: Any) -> None:
@@ -73,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"scenegrep: boxes scored within {args.max_range:g} m of the ego {area}", file=sys.stderr)
     if result.unscored_pairs:
         print(
-            f"scenegrep: {result.unscored_pairs} predicted (log, prompt) pairs are not in the ground truth",
+            f"scenegrep: {counted(result.unscored_pairs, 'predicted (log, prompt) pair')} "
+            f"{verb(result.unscored_pairs, 'be')} not in the ground truth",
             file=sys.stderr,
         )
     return 0

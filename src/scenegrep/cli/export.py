@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
+from ..wording import counted, verb
 
 
 def add_parser(subparsers: Any) -> None:
@@ -120,7 +121,7 @@ def _moments(args: argparse.Namespace, option: str, folder: str) -> Iterator[Any
     failed = source.results.counts()["failed"]
     if not args.quiet and failed:
         print(
-            f"scenegrep: {failed} traces failed in {args.results}: their matches are unknown, none exported",
+            f"scenegrep: {counted(failed, 'trace')} failed in {args.results}: their matches are unknown, none exported",
             file=sys.stderr,
         )
     if not args.quiet and source.results.status == "interrupted":
@@ -137,24 +138,27 @@ def _openscenario(args: argparse.Namespace) -> int:
     summary = write_openscenario(_moments(args, "--openscenario", args.openscenario), args.openscenario)
     if not args.quiet:
         print(
-            f"scenegrep: {len(summary.files)} matches written as OpenSCENARIO 1.3 to {args.openscenario}",
+            f"scenegrep: {counted(len(summary.files), 'match')} written as OpenSCENARIO 1.3 to {args.openscenario}",
             file=sys.stderr,
         )
         if summary.without_road_network:
             print(
-                f"scenegrep: {summary.without_road_network} files have no road network: their traces' maps are not "
+                f"scenegrep: {counted(summary.without_road_network, 'file')} "
+                f"{verb(summary.without_road_network, 'have')} no road network: their traces' maps are not "
                 "OpenDRIVE (said in each file's FileHeader description)",
                 file=sys.stderr,
             )
         if summary.default_size:
             print(
-                f"scenegrep: {summary.default_size} objects lack a labeled length, width or height: written with "
+                f"scenegrep: {counted(summary.default_size, 'object')} {verb(summary.default_size, 'lack')} "
+                "a labeled length, width or height: written with "
                 "their category's default for it (named in each file's FileHeader description)",
                 file=sys.stderr,
             )
         if summary.without_trajectory:
             print(
-                f"scenegrep: {summary.without_trajectory} objects are observed at one frame of their window: "
+                f"scenegrep: {counted(summary.without_trajectory, 'object')} {verb(summary.without_trajectory, 'be')} "
+                "observed at one frame of their window: "
                 "an initial pose, no trajectory",
                 file=sys.stderr,
             )

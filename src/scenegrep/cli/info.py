@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from ..wording import counted
 from .inputs import each_input
 from .options import add_bag_arguments
 
@@ -36,7 +37,8 @@ def _trace_lines(t: dict[str, Any]) -> list[str]:
     duration = "unknown duration" if t["duration_s"] is None else f"{t['duration_s']:.2f} s"
     rate = f" at {t['rate_hz']:.1f} Hz" if t["rate_hz"] else ""
     ego = f", ego {t['ego']}" if t["ego"] else ""
-    lines = [f"  trace {t['name']}: {t['frames']} frames, {duration}{rate}, {t['objects']} objects{ego}"]
+    sizes = f"{counted(t['frames'], 'frame')}, {duration}{rate}, {counted(t['objects'], 'object')}"
+    lines = [f"  trace {t['name']}: {sizes}{ego}"]
     if t["objects"]:
         lines.append(f"    objects per class: {_classes(t['objects_per_class'])}")
         lines.append(f"    states: {t['states']} ({t['states_with_lane']} with a lane)")
@@ -51,16 +53,17 @@ def _trace_lines(t: dict[str, Any]) -> list[str]:
 def _topic_line(t: dict[str, Any]) -> str:
     rate = "" if t["rate_hz"] is None else f", {t['rate_hz']:.1f} Hz"
     skipped = "" if t["decoded"] else " (not read: unsupported type)"
-    return f"  topic {t['topic']}: {t['type']} [{t['encoding']}], {t['messages']} messages{rate}{skipped}"
+    return f"  topic {t['topic']}: {t['type']} [{t['encoding']}], {counted(t['messages'], 'message')}{rate}{skipped}"
 
 
 def _map_lines(m: dict[str, Any]) -> list[str]:
-    stop_lines = f", {m['stop_lines']} stop lines" if m.get("stop_lines") else ""
+    stop_lines = f", {counted(m['stop_lines'], 'stop line')}" if m.get("stop_lines") else ""
     unknown = f"; unknown (not published): {', '.join(m['unknown_layers'])}" if m["unknown_layers"] else ""
     return [
-        f"  map {m['name']}: {m['lanes']} lanes ({m['intersection_lanes']} in intersections), "
-        f"{m['roads']} roads, {m['intersections']} intersections, {m['crosswalks']} crosswalks, "
-        f"{m['sidewalks']} sidewalks, {m['curbs']} curbs{stop_lines}{unknown}; "
+        f"  map {m['name']}: {counted(m['lanes'], 'lane')} ({m['intersection_lanes']} in intersections), "
+        f"{counted(m['roads'], 'road')}, {counted(m['intersections'], 'intersection')}, "
+        f"{counted(m['crosswalks'], 'crosswalk')}, {counted(m['sidewalks'], 'sidewalk')}, "
+        f"{counted(m['curbs'], 'curb')}{stop_lines}{unknown}; "
         f"extent {m['extent_m'][0]} x {m['extent_m'][1]} m"
     ]
 

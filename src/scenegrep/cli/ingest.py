@@ -14,6 +14,7 @@ import sys
 from typing import Any
 
 from .exit_codes import EXIT_SOME_FAILED
+from ..wording import counted
 from .options import add_jobs_argument, add_map_argument, add_unknown_layers_argument, report_unknown_layers
 
 
@@ -57,7 +58,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"scenegrep: error: {error if error.startswith(path) else f'{path}: {error}'}", file=sys.stderr)
     if not args.quiet:
         print(
-            f"scenegrep: {report.ingested} sources ingested ({report.traces} traces), {report.unchanged} unchanged, "
+            f"scenegrep: {counted(report.ingested, 'source')} ingested ({counted(report.traces, 'trace')}), "
+            f"{report.unchanged} unchanged, "
             f"{len(report.failed)} failed; dataset {args.into}",
             file=sys.stderr,
         )

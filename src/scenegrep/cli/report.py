@@ -12,6 +12,7 @@ import sys
 from typing import Any
 
 from .options import check_output_file
+from ..wording import counted
 
 
 def add_parser(subparsers: Any) -> None:
@@ -43,5 +44,6 @@ def run(args: argparse.Namespace) -> int:
     written = write_report(source, args.output, progress)
     if not args.quiet:
         matches = source.results.matches.num_rows
-        print(f"scenegrep: report of {matches} matches in {args.output} ({written} trace views)", file=sys.stderr)
+        views = counted(written, "trace view")
+        print(f"scenegrep: report of {counted(matches, 'match')} in {args.output} ({views})", file=sys.stderr)
     return 0

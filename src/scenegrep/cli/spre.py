@@ -168,6 +168,8 @@ def _run_streams(args: argparse.Namespace) -> int:
         many = path != "-" and readers.FORMATS[readers.detect_format(path)].many
         for trace in readers.read_traces(path):
             bound = TraceSearch(query, trace, options)
+            for warning in [] if args.quiet else bound.warnings:
+                print(f"scenegrep: warning: {path if path != '-' else '<stdin>'}: {warning}", file=sys.stderr)
             matches = bound.online() if args.online else bound.offline()
             prefix = "" if path == "-" else f"{path}#{trace.name}" if many else path
             found |= _report(matches, path, prefix, args, options, bound.trace)

@@ -15,6 +15,7 @@ import argparse
 import sys
 from pathlib import Path
 from typing import Any
+from ..wording import counted
 
 
 def add_parser(subparsers: Any) -> None:
@@ -91,5 +92,5 @@ def run(args: argparse.Namespace) -> int:
     progress = bar(traces, args.quiet, total=args.runs, desc=Path(args.program).name, unit="run")
     written = folder.write(progress, args.program, args.map)
     if not args.quiet:
-        print(f"scenegrep: wrote {written} traces and {MANIFEST} to {folder.path}", file=sys.stderr)
+        print(f"scenegrep: wrote {counted(written, 'trace')} and {MANIFEST} to {folder.path}", file=sys.stderr)
     return 0

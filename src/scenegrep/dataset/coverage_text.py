@@ -4,6 +4,7 @@ bin, the gaps and the ambiguous matches; the joint coverage of pairs; bins cover
 from __future__ import annotations
 
 from .coverage import AMBIGUOUS, NO_VALUE, Coverage
+from ..wording import counted
 
 MOST_SOURCES = 20
 """Sources listed in the per-source part (the table has them all)."""
@@ -13,8 +14,9 @@ def summary_text(coverage: Coverage, program: str) -> str:
     """The summary, several lines (no trailing newline)."""
     rows = coverage.rows
     lines = [
-        f"coverage of {program}: {len(rows)} matches in {len({r['trace_id'] for r in rows})} traces "
-        f"from {len(coverage.sources)} sources; {coverage.ambiguous()} ambiguous (an interval over several bins), "
+        f"coverage of {program}: {counted(len(rows), 'match')} in "
+        f"{counted(len({r['trace_id'] for r in rows}), 'trace')} from {counted(len(coverage.sources), 'source')}; "
+        f"{coverage.ambiguous()} ambiguous (an interval over several bins), "
         f"{coverage.several()} with several correspondences"
     ]
     if coverage.unknown:

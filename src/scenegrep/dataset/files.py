@@ -39,6 +39,7 @@ from .queries import (
 from .results import Results
 from .run import run_id_of
 from .statistics import time_origin_ns
+from .vocabulary import Vocabulary, channels_of, query_warnings
 
 RowsCallback = Callable[[list[dict[str, Any]]], None]
 
@@ -52,9 +53,11 @@ def query_files(
     are ready. The results are ordered as a dataset run's, with its run id, and count the
     decisions the choice for unknown map layers affected, as a run's do."""
     sources, bad = discover(paths)
-    tables, assumed = decisions_while(spec, lambda: _tables(spec, sources, bad, map_path, on_rows))
+    vocabulary = Vocabulary()
+    tables, assumed = decisions_while(spec, lambda: _tables(spec, sources, bad, map_path, on_rows, vocabulary))
     table = pa.concat_tables([results_table([]), *tables]).sort_by(ORDER)
-    return Results(table, run_id_of(spec), query=spec.key(), assumed=assumed)
+    warnings = query_warnings(spec, compiled(spec), vocabulary)
+    return Results(table, run_id_of(spec), query=spec.key(), assumed=assumed, warnings=warnings)
 
 
 def _tables(
@@ -63,11 +66,13 @@ def _tables(
     bad: list[tuple[str, str]],
     map_path: str | None,
     on_rows: RowsCallback | None,
+    vocabulary: Vocabulary,
 ) -> list[pa.Table]:
-    """Each batch of rows (:func:`_batches`) as a table, shown to ``on_rows`` as it is ready."""
+    """Each batch of rows (:func:`_batches`) as a table, shown to ``on_rows`` as it is ready; the
+    names of the traces read go into ``vocabulary``."""
     tables = []
     with TracePlanner(needs_of(spec, compiled(spec))) as planner:
-        for batch in _batches(spec, planner, sources, bad, map_path):
+        for batch in _batches(spec, planner, sources, bad, map_path, vocabulary):
             tables.append(results_table(batch))
             if on_rows is not None:
                 on_rows(tables[-1].to_pylist())
@@ -88,13 +93,18 @@ def read_queried_trace(
 
 
 def _batches(
-    spec: QuerySpec, planner: TracePlanner, sources: list[Source], bad: list[tuple[str, str]], map_path: str | None
+    spec: QuerySpec,
+    planner: TracePlanner,
+    sources: list[Source],
+    bad: list[tuple[str, str]],
+    map_path: str | None,
+    vocabulary: Vocabulary,
 ) -> Iterator[list[dict[str, Any]]]:
     """The rows of each bad path, then of each trace of each source, in order."""
     for path, error in bad:
         yield [_failed(path, 0, error)]
     for source in sources:
-        yield from _source_rows(spec, planner, source, map_path)
+        yield from _source_rows(spec, planner, source, map_path, vocabulary)
 
 
 def _failed(path: str, number: int, error: str) -> dict[str, Any]:
@@ -105,19 +115,25 @@ def _failed(path: str, number: int, error: str) -> dict[str, Any]:
 
 
 def _source_rows(
-    spec: QuerySpec, planner: TracePlanner, source: Source, map_path: str | None
+    spec: QuerySpec, planner: TracePlanner, source: Source, map_path: str | None, vocabulary: Vocabulary
 ) -> Iterator[list[dict[str, Any]]]:
     """Each trace's rows of one source, then, if reading it failed, the source's failed row."""
     number = 0
     try:
         for number, trace in enumerate(readers.read_traces(source.path, source.format)):
-            yield _trace_rows(spec, planner, source.path, number, trace, map_path)
+            yield _trace_rows(spec, planner, source.path, number, trace, map_path, vocabulary)
     except Exception as exc:  # a bad source must not stop the others
         yield [_failed(source.path, number, failure_text(exc, source.path))]
 
 
 def _trace_rows(
-    spec: QuerySpec, planner: TracePlanner, source: str, number: int, trace: LabelTrace, map_path: str | None
+    spec: QuerySpec,
+    planner: TracePlanner,
+    source: str,
+    number: int,
+    trace: LabelTrace,
+    map_path: str | None,
+    vocabulary: Vocabulary,
 ) -> list[dict[str, Any]]:
     trace_id = trace_id_of(source, trace.name, number)
     identity = {"trace_id": trace_id, "name": trace.name, "source": source, "time_origin_ns": time_origin_ns(trace)}
@@ -128,6 +144,8 @@ def _trace_rows(
             prepare_trace(trace, labelled, spec_choice(spec), map_path) if uses_map(spec) else (trace, None)
         )
         row, statistics = catalog_row(prepared, trace_id, source, "", None)
+        vocabulary.add_counts(statistics.frame_counts)
+        vocabulary.add_channels(channels_of(prepared))
         reason = planner.prune_reason(row, statistics)
         if reason is not None:
             return [pruned_row(reason)]

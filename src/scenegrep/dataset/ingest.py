@@ -34,6 +34,7 @@ from .catalog import Catalog
 from .execute import run_all
 from .labelling import COLUMN, labelled, recorded_choice
 from .statistics import TraceStatistics
+from ..wording import article
 
 COMMIT_EVERY = 16
 """Sources committed to the catalog per transaction (each trace is atomic either way)."""
@@ -134,7 +135,8 @@ def _file_format(path: Path, explicit: bool) -> str | None:
     if explicit:
         name = readers.detect_format(path)
         if not readers.FORMATS[name].traces:
-            raise UserError(f"a {readers.FORMATS[name].description} holds no label trace", at(path))
+            description = readers.FORMATS[name].description
+            raise UserError(f"{article(description)} {description} holds no label trace", at(path))
         return name
     name = readers.sniff_file(path)
     return name if name is not None and name not in readers.SKIPPED and readers.FORMATS[name].traces else None

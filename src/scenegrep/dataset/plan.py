@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import UserError
+from ..wording import counted
 from .catalog import Catalog
 from .queries import QuerySpec
 
@@ -36,8 +37,8 @@ class KindGroup:
     count: int
 
     def describe(self) -> str:
-        what = "objects" if self.kinds is None else "/".join(sorted(self.kinds)) + " objects"
-        return f"{self.count} {what}"
+        what = "object" if self.kinds is None else "/".join(sorted(self.kinds)) + " object"
+        return counted(self.count, what)
 
 
 @dataclass(frozen=True)
@@ -149,7 +150,8 @@ def _prune_by_groups(catalog: Catalog, needs: Needs) -> dict[str, str]:
     """
     together = " and ".join(g.describe() for g in needs.groups)
     return {
-        trace_id: f"never {together} present together for {int(needed)} consecutive frames (at most {longest})"
+        trace_id: f"never {together} present together for {counted(int(needed), 'consecutive frame')} "
+        f"(at most {longest})"
         for trace_id, longest, needed in catalog.rows(query)
     }
 

@@ -364,35 +364,38 @@ class TraceTask:
 
 @dataclass(frozen=True)
 class ChunkRows:
-    """What a worker sends back for a chunk of traces: their ``rows`` and, per map layer, the
-    decisions the choice for unknown layers affected (``assumed``), for the run's report."""
+    """What a worker sends back for a chunk of traces: their ``rows``, per map layer the
+    decisions the choice for unknown layers affected (``assumed``), and the image ``channels``
+    of the traces it read, for the run's report."""
 
     rows: list[dict[str, Any]]
     assumed: dict[str, int]
+    channels: tuple[str, ...] = ()
 
 
 def run_tasks(work: tuple[QuerySpec, str | None, list[TraceTask]]) -> ChunkRows:
     """Query a chunk of traces (runs in a worker): ``work`` is the spec, a fallback map path for
     traces without one, and the tasks. A trace that fails to load or query gives a 'failed' row."""
     spec, fallback_map, tasks = work
+    channels: set[str] = set()
     rows, assumed = decisions_while(
-        spec, lambda: [row for task in tasks for row in _query_task(spec, task, fallback_map)]
+        spec, lambda: [row for task in tasks for row in _query_task(spec, task, fallback_map, channels)]
     )
-    return ChunkRows(rows, assumed)
+    return ChunkRows(rows, assumed, tuple(sorted(channels)))
 
 
-def _query_task(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> list[dict[str, Any]]:
-    """One task's rows (:func:`query_trace`)."""
+def _query_task(spec: QuerySpec, task: TraceTask, fallback_map: str | None, channels: set[str]) -> list[dict[str, Any]]:
+    """One task's rows (:func:`query_trace`); the trace's image channels go into ``channels``."""
     identity = {
         "trace_id": task.trace_id,
         "name": task.name,
         "source": task.source,
         "time_origin_ns": task.time_origin_ns,
     }
-    return query_trace(identity, task.file, lambda: _task_rows(spec, task, fallback_map))
+    return query_trace(identity, task.file, lambda: _task_rows(spec, task, fallback_map, channels))
 
 
-def _task_rows(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> list[dict[str, Any]]:
+def _task_rows(spec: QuerySpec, task: TraceTask, fallback_map: str | None, channels: set[str]) -> list[dict[str, Any]]:
     """One ingested trace's rows; a scenario query reads its labels under the query's choice for
     unknown map layers, labelled on its map as a query over files labels it (:func:`.labelling.labelled`);
     its map is its own, else ``fallback_map`` (:func:`scenegrep.readers.with_given_map`)."""
@@ -400,6 +403,8 @@ def _task_rows(spec: QuerySpec, task: TraceTask, fallback_map: str | None) -> li
     from .labelling import labelled
 
     trace = readers.read_trace(task.file, "scenegrep-parquet")
+    if trace.images is not None:
+        channels.update(trace.images.samples.channels)
     if not uses_map(spec):
         return match_trace(spec, trace, None)
     if task.map_file and fallback_map:

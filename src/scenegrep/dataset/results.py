@@ -31,13 +31,15 @@ class Results:
     'interrupted': then only the traces done so far have rows besides the pruned ones), its
     ``query`` (:meth:`QuerySpec.key <scenegrep.dataset.queries.QuerySpec.key>`; "" when unknown)
     and, per map layer, how many decisions of the run the choice for unknown layers affected
-    (``assumed``: for the report on stderr; not kept in results files)."""
+    (``assumed``), and the ``warnings`` for names the query uses that no searched trace has
+    (:mod:`.vocabulary`): both for the report on stderr, not kept in results files."""
 
     table: pa.Table
     run_id: str = ""
     status: str = "finished"
     query: str = ""
     assumed: dict[str, int] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
 
     @classmethod
     def read(cls, path: str | Path) -> Results:

@@ -32,12 +32,16 @@ from .labelling import catalog_value
 from .plan import Plan, needs_of, plan
 from .queries import ORDER, QuerySpec, TraceTask, compiled, pruned_row, results_table, run_tasks
 from .results import RESULTS_FILE, Results
+from .vocabulary import Vocabulary, query_warnings
 
 MAX_CHUNK = 64
 """At most this many traces per task: results are saved (and progress shown) per chunk."""
 
 ASSUMED_KEY = b"scenegrep.assumed"
 """Key of a part's decisions per unknown map layer (a JSON object) in its Parquet metadata."""
+
+CHANNELS_KEY = b"scenegrep.channels"
+"""Key of the image channels of a part's traces (a JSON list) in its Parquet metadata."""
 
 
 @dataclass(frozen=True)
@@ -67,9 +71,11 @@ def run_query(
     query = compiled(spec)
     run_id = run_id_of(spec)
     folder = root / "runs" / run_id
+    vocabulary = Vocabulary()
     with Catalog(root) as catalog:
         planned = plan(catalog, needs_of(spec, query))
         maps = dict(catalog.rows("SELECT map_id, file FROM maps"))
+        vocabulary.add_catalog(catalog)
         catalog.start_run(run_id, spec.kind, spec.text, json.dumps(dict(spec.options)))
     if on_plan is not None:
         on_plan(planned)
@@ -81,7 +87,7 @@ def run_query(
     done = _finished_traces(parts)
     todo = [_task(root, row, maps) for row in planned.kept if row["trace_id"] not in done]
     status = _execute(spec, todo, parts, options, len(planned.kept), len(done))
-    return _finish(root, spec, status, parts, planned)
+    return _finish(root, spec, status, parts, planned, vocabulary)
 
 
 def identity_of(row: dict[str, Any]) -> dict[str, Any]:
@@ -132,7 +138,8 @@ def _execute(spec: QuerySpec, todo: list[TraceTask], parts: Path, options: RunOp
     try:
         for number, chunk in run_all(run_tasks, work, options.jobs, options.engine, options.address):
             name = hashlib.sha256("\0".join(t.trace_id for t in chunks[number]).encode()).hexdigest()[:16]
-            table = results_table(chunk.rows).replace_schema_metadata({ASSUMED_KEY: json.dumps(chunk.assumed)})
+            metadata = {ASSUMED_KEY: json.dumps(chunk.assumed), CHANNELS_KEY: json.dumps(chunk.channels)}
+            table = results_table(chunk.rows).replace_schema_metadata(metadata)
             with atomic_path(parts / f"{name}.parquet") as tmp:
                 pq.write_table(table, tmp)
             matched += len({r["trace_id"] for r in chunk.rows if r["status"] == "match"})
@@ -153,13 +160,18 @@ def _assumed(parts: list[pa.Table]) -> dict[str, int]:
     return dict(total)
 
 
-def _finish(root: Path, spec: QuerySpec, status: str, parts: Path, planned: Plan) -> Results:
-    """Gather the parts and the pruned traces into the results; write them out and to the catalog."""
+def _finish(root: Path, spec: QuerySpec, status: str, parts: Path, planned: Plan, vocabulary: Vocabulary) -> Results:
+    """Gather the parts and the pruned traces into the results, with the warnings for the names the
+    query uses that no trace has (classes from the catalog, image channels from the parts); write
+    them out and to the catalog."""
     tables = [pq.read_table(p) for p in sorted(parts.glob("*.parquet"))]
+    for part in tables:
+        vocabulary.add_channels(json.loads((part.schema.metadata or {}).get(CHANNELS_KEY, b"[]")))
     pruned = [{**identity_of(row), **pruned_row(reason)} for row, reason in planned.pruned]
     table = pa.concat_tables([results_table(pruned), *(t.replace_schema_metadata(None) for t in tables)])
     run_id = run_id_of(spec)
-    results = Results(table.sort_by(ORDER), run_id, status, spec.key(), _assumed(tables))
+    warnings = query_warnings(spec, compiled(spec), vocabulary)
+    results = Results(table.sort_by(ORDER), run_id, status, spec.key(), _assumed(tables), warnings)
     results.write_parquet(root / "runs" / run_id / RESULTS_FILE)
     with Catalog(root) as catalog:
         catalog.finish_run(run_id, status, table, results.counts())

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..model import LabelTrace
+from ..wording import counted
 
 
 @dataclass
@@ -51,13 +52,14 @@ class LabelStatistics:
     def table(self) -> str:
         """A text table: one line per class (most observed first), each behaviour's share of
         the class's observations in percent and the mean label-set size."""
-        lines = [f"{self.traces} traces; per class: objects, observations, mean set size, % of observations"]
+        lines = [f"{counted(self.traces, 'trace')}; per class: objects, observations, mean set size, % of observations"]
         for name, c in sorted(self.classes.items(), key=lambda item: -item[1].observations):
             shares = "  ".join(
                 f"{b} {100.0 * n / c.observations:.1f}" for b, n in sorted(c.behaviours.items(), key=lambda i: -i[1])
             )
             lines.append(
-                f"  {name}: {c.objects} objects, {c.observations} obs, {c.set_size / c.observations:.2f}  {shares}"
+                f"  {name}: {counted(c.objects, 'object')}, {c.observations} obs, "
+                f"{c.set_size / c.observations:.2f}  {shares}"
             )
         return "\n".join(lines)
 

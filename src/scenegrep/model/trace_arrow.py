@@ -27,6 +27,7 @@ from .images import BoxTable, ImageLayer, SampleTable
 from .objects import ObjectTable
 from .states import FLOAT_COLUMNS, StateTable
 from .trace import LabelTrace, MapSource, TraceSource, checked_frame_count
+from ..wording import plural
 
 METADATA_KEY = b"scenegrep"
 LAYOUT_VERSION = 1
@@ -288,10 +289,10 @@ def trace_from_table(table: pa.Table) -> LabelTrace:
         raise ValueError(f"unsupported trace layout {meta.get('layout')!r} (this scenegrep reads {LAYOUT_VERSION})")
     missing = [name for name in SCHEMA.names if name not in table.column_names]
     if missing:
-        raise ValueError(f"missing column(s) {', '.join(missing)}")
+        raise ValueError(f"missing {plural('column', len(missing))} {', '.join(missing)}")
     absent = [key for key in _META_KEYS if key not in meta]
     if absent:
-        raise ValueError(f"missing metadata field(s) {', '.join(absent)}")
+        raise ValueError(f"missing metadata {plural('field', len(absent))} {', '.join(absent)}")
     kind = _codes(table.column("kind"), list(KINDS))
     position = _numpy(table, "position", np.int64)
     n_frames = checked_frame_count(int(position.max()) + 1 if len(position) else 0)

@@ -33,6 +33,7 @@ from ..errors import UserError, at
 from ..model import LabelTrace, MapSource
 from .common import malformed
 from .common import regular_file
+from ..wording import article
 
 if TYPE_CHECKING:
     from ..model import RoadMap
@@ -172,7 +173,9 @@ def _checked(path: str | Path, format_name: str | None, need: str) -> str:
         raise UserError(f"unknown format {name!r}; supported: {', '.join(FORMATS)}", at(path))
     if not getattr(FORMATS[name], need):
         raise UserError(
-            f"a {FORMATS[name].description} holds no {'label trace' if need == 'traces' else 'road map'}", at(path)
+            f"{article(FORMATS[name].description)} {FORMATS[name].description} holds no "
+            f"{'label trace' if need == 'traces' else 'road map'}",
+            at(path),
         )
     return name
 

@@ -22,6 +22,7 @@ from ..model.trace import checked_frame_count
 from .av2_map import FORMAT as MAP_FORMAT
 from .av2_map import find_map
 from .common import reading
+from ..wording import plural
 
 FORMAT = "av2-forecasting"
 EGO_ID = "AV"
@@ -58,7 +59,7 @@ def read_trace(path: str | Path) -> LabelTrace:
         table = pq.read_table(file)
     missing = [c for c in _COLUMNS if c not in table.column_names]
     if missing:
-        raise UserError(f"missing column(s) {', '.join(missing)}", at(file))
+        raise UserError(f"missing {plural('column', len(missing))} {', '.join(missing)}", at(file))
     col = {c: table.column(c).to_numpy(zero_copy_only=False) for c in table.column_names}
     tracks, track_row = np.unique(col["track_id"].astype(str), return_inverse=True)
     if table.num_rows == 0:

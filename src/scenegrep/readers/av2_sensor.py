@@ -27,6 +27,7 @@ from ..model.kinematics import ESTIMATED_VELOCITY, with_derived_velocity
 from .av2_map import FORMAT as MAP_FORMAT
 from .av2_map import find_map
 from .common import reading
+from ..wording import plural
 
 FORMAT = "av2-sensor"
 ANNOTATIONS = "annotations.feather"
@@ -64,7 +65,7 @@ def _columns(path: Path, names: tuple[str, ...]) -> dict[str, np.ndarray]:
         table.validate(full=True)  # Feather buffers are used as they lie: a bad offset crashes Arrow later
     missing = [n for n in names if n not in table.column_names]
     if missing:
-        raise UserError(f"missing column(s) {', '.join(missing)}", at(path))
+        raise UserError(f"missing {plural('column', len(missing))} {', '.join(missing)}", at(path))
     if table.num_rows == 0:
         raise UserError("holds no rows", at(path))
     return {n: table.column(n).to_numpy(zero_copy_only=False) for n in names}

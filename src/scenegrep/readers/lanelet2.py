@@ -62,6 +62,7 @@ from ..model.lane_topology import derive_intersections, derive_roads
 from . import map_cache
 from .osm_xml import Element, OsmDocument, read_osm
 from .utm import to_mgrs_local
+from ..wording import counted
 
 FORMAT = "lanelet2"
 CONVERSION_VERSION = 1
@@ -161,7 +162,9 @@ class _Reader:
         except KeyError as exc:
             raise self.fail(way, f"way {way_id} refers to node {exc.args[0]}, which the map does not hold") from None
         if len(rows) < min_points:
-            raise self.fail(way, f"way {way_id} ({what}) has {len(rows)} node(s); it needs at least {min_points}")
+            raise self.fail(
+                way, f"way {way_id} ({what}) has {counted(len(rows), 'node')}; it needs at least {min_points}"
+            )
         return list(way.refs), self.xy[rows]
 
     def member(self, relation: Element, relation_id: str, role: str, required: bool = True) -> str | None:
@@ -169,7 +172,7 @@ class _Reader:
         found = [ref for kind, ref, r in relation.members if r == role and kind == "way"]
         if len(found) > 1 or (required and not found):
             count = "several" if found else "no"
-            raise self.fail(relation, f"relation {relation_id} has {count} {role!r} way member(s); it needs one")
+            raise self.fail(relation, f"relation {relation_id} has {count} {role!r} way members; it needs one")
         return found[0] if found else None
 
     def bounds(self, relation_id: str, relation: Element) -> _Bounds:

@@ -16,6 +16,7 @@ from pathlib import Path
 from xml.parsers import expat
 
 from ..errors import UserError, at
+from ..wording import article
 
 MAX_BYTES = 512 * 1024 * 1024
 """The largest map file read (a city's Autoware map is tens of megabytes)."""
@@ -65,7 +66,7 @@ class _Builder:
     def required(self, attributes: dict[str, str], name: str, element: str) -> str:
         value = attributes.get(name)
         if value is None:
-            raise self.fail(f"<{element}> without a {name!r} attribute")
+            raise self.fail(f"<{element}> without {article(name)} {name!r} attribute")
         return value
 
     def start(self, name: str, attributes: dict[str, str]) -> None:

@@ -26,6 +26,7 @@ from .hfsm import CAN_FALSE, CAN_TRUE, Config, Hfsm
 from .search import Assignment, Outcome, Search
 from .translate import Guard
 from .vocabulary import STATIONARY
+from ..wording import counted
 
 _GUARD_TEXT = {CAN_TRUE: "true", CAN_FALSE: "false", CAN_TRUE | CAN_FALSE: "true or false"}
 
@@ -88,7 +89,7 @@ class Explainer:
         assignment = self._assignment(correspondence)
         m = self.search.m
         lines = [
-            f"window {self.frame(start)} to {self.frame(start + m - 1)} ({m} frames); "
+            f"window {self.frame(start)} to {self.frame(start + m - 1)} ({counted(m, 'frame')}); "
             + ", ".join(f"{name} = {label}" for name, label in correspondence.items())
         ]
         runs = {obj: self.run(obj, assignment, start, m) for obj in self.hfsms}
@@ -116,7 +117,7 @@ class Explainer:
         out = self.outcome
         m = self.search.m
         if self.search.n_starts <= 0:
-            return f"the trace has {self.trace.n_frames} frames, fewer than the window of {m}"
+            return f"the trace has {counted(self.trace.n_frames, 'frame')}, fewer than the window of {m}"
         for obj, cands in out.candidates.items():
             if not cands:
                 program_object = self.program.object(obj)
@@ -126,14 +127,16 @@ class Explainer:
                 )
         for obj, kept in out.unary.items():
             if not kept:
-                return f"no candidate for {obj} behaves as its HFSM for {m} frames: " + self._furthest_unary(obj)
+                return f"no candidate for {obj} behaves as its HFSM for {counted(m, 'frame')}: " + self._furthest_unary(
+                    obj
+                )
         if not out.feasible:
             names = ", ".join(f"{o} ({len(k)})" for o, k in out.unary.items())
             return f"the program objects cannot take distinct label objects (candidates: {names})"
         if out.scene_failures:
             assignment, starts = out.scene_failures[0]
             return (
-                f"the behaviours match from {len(starts)} window start(s) with {self._names(assignment)}, "
+                f"the behaviours match from {counted(len(starts), 'window start')} with {self._names(assignment)}, "
                 f"but the initial scene holds at none of them; {self._scene_failure(assignment, starts)}"
             )
         best = out.best

@@ -28,6 +28,7 @@ import numpy as np
 
 from .tolerance import Tolerance
 from .match import TraceMatches, match_trace
+from ..wording import counted, plural
 
 if TYPE_CHECKING:
     from .query import SceneResult
@@ -287,13 +288,12 @@ class NearestMisses:
     def summary(self) -> str:
         """What was examined, and the bounds."""
         text = (
-            f"nearest misses searched in {self.frames} frames of {self.traces} trace(s) "
-            f"(at most {self.limits.frames} frames per trace, {self.limits.traces} traces, tolerances up to "
-            + ", ".join(f"{name} {cap:.4g} {UNITS[name]}" for name, cap in CAPS.items())
-            + ")"
+            f"nearest misses searched in {counted(self.frames, 'frame')} of {counted(self.traces, 'trace')} "
+            f"(at most {counted(self.limits.frames, 'frame')} per trace, {counted(self.limits.traces, 'trace')}, "
+            "tolerances up to " + ", ".join(f"{name} {cap:.4g} {UNITS[name]}" for name, cap in CAPS.items()) + ")"
         )
         if self.skipped:
-            text += f"; {self.skipped} more trace(s) not examined"
+            text += f"; {self.skipped} more {plural('trace', self.skipped)} not examined"
         if self.holding:
             text += (
                 f"; the scene holds in {self.holding} of them (a scenario's behaviours fail there: "

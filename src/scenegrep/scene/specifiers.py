@@ -48,6 +48,7 @@ from .regions import (
 from .terms import RandomPoint, RandomVariable, Term
 from .lenient_boxes import eased
 from .values import Delayed, Instance, SelfView, Vec, observed_view, type_name
+from ..wording import article
 
 
 @dataclass(frozen=True)
@@ -155,7 +156,7 @@ def construct(r: Context, node: ir.New, name: str) -> Instance:
     if spec.is_object:
         _add_scene_object(r, instance, chosen, modifiers, node, behaviour)
     elif behaviour is not None:
-        raise r.error(f"a {spec.name} cannot have a behaviour", behaviour)
+        raise r.error(f"{article(spec.name)} {spec.name} cannot have a behaviour", behaviour)
     return instance
 
 
@@ -202,7 +203,8 @@ def _check_types(r: Context, instance: Instance, node: ir.New) -> None:
     for prop, kind in expected.items():
         value = instance.defining.get(prop)
         if value is not None and not isinstance(value, kind):
-            raise r.error(f"the {prop} of a {instance.spec.name} cannot be {type_name(value)}", node)
+            name = instance.spec.name
+            raise r.error(f"the {prop} of {article(name)} {name} cannot be {type_name(value)}", node)
 
 
 def _add_scene_object(

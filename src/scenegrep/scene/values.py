@@ -19,6 +19,7 @@ from typing import Any
 from ..scenic import ir
 from .domain import ClassSpec
 from .terms import Term, TermFactory
+from ..wording import article
 
 
 @dataclass(frozen=True)
@@ -102,9 +103,10 @@ def type_name(value: Any) -> str:
     if isinstance(value, Vec):
         return "a vector"
     if isinstance(value, Instance):
-        return f"an object ({value.spec.name})" if value.is_object else f"a {value.spec.name}"
+        return f"an object ({value.spec.name})" if value.is_object else f"{article(value.spec.name)} {value.spec.name}"
     if isinstance(value, Delayed):
         return "a value that depends on the object being created"
     if isinstance(value, tuple):
         return "a sequence"
-    return f"a {type(value).__name__.lower()}"
+    name = type(value).__name__.lower()
+    return f"{article(name)} {name}"

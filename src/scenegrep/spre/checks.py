@@ -14,6 +14,7 @@ from ..errors import UserError
 from . import syntax as s
 from .errors import query_error
 from .tokens import MAX_NESTING, MAX_NODES, MAX_POSITIONS, TOO_DEEP
+from ..wording import plural
 
 FUNCTIONS: dict[str, tuple[int, ...]] = {
     "x": (1,),
@@ -86,7 +87,8 @@ class _Checker:
             raise self.fail(f"unknown function @{node.name}; known: {known}", node)
         if len(node.args) not in table[node.name]:
             counts = " or ".join(str(n) for n in table[node.name])
-            raise self.fail(f"@{node.name} takes {counts} argument(s), not {len(node.args)}", node)
+            arguments = plural("argument", max(table[node.name]))
+            raise self.fail(f"@{node.name} takes {counts} {arguments}, not {len(node.args)}", node)
 
 
 _QUERY_NODES = (s.Letter, s.AnyFrame, s.Concat, s.Alternation, s.Repeat, s.TrackBinder, s.Empty)

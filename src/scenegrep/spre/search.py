@@ -163,10 +163,29 @@ class TraceSearch:
             trace = trace.slice_frames(options.skip, trace.n_frames)
         self.query = query
         self.trace = trace
+        self.options = options
         self.evaluator = Evaluator(build_space(trace, options, query.compat), strem=query.compat)
         self.candidates = _candidates(query, self.evaluator)
         self.automaton = query.automaton_over(self.candidates)
         self.masks = letter_masks(self.automaton, self.evaluator, query, trace)
+
+    @property
+    def warnings(self) -> list[str]:
+        """One line per class name of the query and image channel of the options that this trace
+        lacks (:mod:`scenegrep.spre.vocabulary`; classes of all its channels): names that can never
+        hold here."""
+        from ..model.taxonomy import kind_of
+        from .vocabulary import unknown_channels, unknown_classes
+
+        images = self.trace.images
+        if self.evaluator.space.kind == "image" and images is not None:
+            present = {images.boxes.classes[code] for code in np.unique(images.boxes.category)}
+        else:
+            present = set(self.trace.objects.category.astype(str).tolist())
+        found = unknown_classes(self.query, [(category, kind_of(category)) for category in present])
+        if self.options.channels and images is not None:
+            found += unknown_channels(self.options.channels, images.samples.channels)
+        return found
 
     def matches(self, spans: Iterable[tuple[int, int]]) -> Iterator[Match]:
         """Matches of the given (start, end) position pairs."""

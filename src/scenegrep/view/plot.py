@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import UserError
 from ..model.geometry import box_corners
+from ..wording import numbered
 from .data import MatchView, TraceView, image_channels
 from .style import (
     MARKED_COLOUR,
@@ -113,7 +114,7 @@ def _frame(view: TraceView, match: MatchView | None, frame: int | None) -> int:
     if frame is None:
         return match.first if match is not None else 0
     if not 0 <= frame < view.trace.n_frames:
-        raise UserError(f"--frame {frame}: the trace has frames 0 to {view.trace.n_frames - 1}")
+        raise UserError(f"--frame {frame}: the trace has {numbered(view.trace.n_frames, 'frame')}")
     return frame
 
 

@@ -22,6 +22,7 @@ from ..dataset.catalog import CATALOG_FILE, Catalog, catalog_file
 from ..dataset.results import Results
 from ..errors import UserError, at
 from .data import QueryInfo, TraceView, build_view
+from ..wording import numbered
 
 
 def find_dataset(path: str | Path) -> Path | None:
@@ -123,9 +124,7 @@ class ResultsSource:
         """The ``number``-th match of the table (0-based, in table order)."""
         matches = self.results.matches
         if not 0 <= number < matches.num_rows:
-            raise UserError(
-                f"--match {number}: the results have {matches.num_rows} matches (0 to {matches.num_rows - 1})"
-            )
+            raise UserError(f"--match {number}: the results have {numbered(matches.num_rows, 'match')}")
         return matches.slice(number, 1).to_pylist()[0]
 
 

@@ -61,7 +61,7 @@ def both(query_spec, paths, dataset):
 
 
 def test_class_names_leave_out_any_and_ego():
-    assert class_names(compile_query("[[:*:] & [:ego:]][[:cra:] | [:car:]]")) == {"cra", "car"}
+    assert class_names(compile_query("[[:*:] & [:ego:]][[:cra:] | [:car:]]").tree) == {"cra", "car"}
 
 
 def test_an_unknown_class_names_the_known_ones_in_both_modes(dataset, stream, names):

@@ -69,7 +69,7 @@ def test_kind_pruning_keeps_every_trace_that_could_match(tmp_path_factory, trace
         assert result.kept and not result.pruned
     if not result.pruned:
         return
-    assert "consecutive frames" in result.pruned[0][1]
+    assert "consecutive frame" in result.pruned[0][1]
 
 
 @settings(max_examples=25, deadline=None)

@@ -242,7 +242,7 @@ def test_cli_refuses_bad_options_and_targets(tmp_path, capsys):
         code, err = run(["export", results, *bad], capsys)
         assert code == 2 and message in err and "Traceback" not in err, (bad, err)
     code, err = run(["export", results, "--scenic", tmp_path / "o", "--context", "3"], capsys)
-    assert code == 0 and "1 matches written as Scenic programs" in err
+    assert code == 0 and "1 match written as Scenic programs" in err
     assert "1 programs without a road map (the trace has no road map)" in err
     (program,) = (tmp_path / "o").iterdir()
     assert program.name == "walk-0.scenic" and "with name 'c'" in program.read_text()  # c: 2 m from w
@@ -260,7 +260,7 @@ def test_failed_traces_and_interrupted_runs_are_said_not_silently_skipped(target
     results = tmp_path / "r.parquet"
     Results(results_table([row, failed]), "run", "interrupted").write_parquet(results)
     code, err = run(["export", results, target, tmp_path / "out"], capsys)
-    assert code == 0 and "1 matches written" in err, err
+    assert code == 0 and "1 match written" in err, err
     assert "1 trace failed" in err and "none exported" in err and "an interrupted run" in err
     assert len(list((tmp_path / "out").iterdir())) == 1
 

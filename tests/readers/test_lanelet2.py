@@ -225,7 +225,7 @@ MALFORMED = [
     ("<map><node id='1'/></map>", r":1:\d+: the root element is <map>"),
     ("<osm><node id='1'><tag k='a' v='b'><x><y/></x></tag></node></osm>", r"nested deeper than 4"),
     ("<osm><node id='1' lat='0' lon='0'/><node id='1' lat='0' lon='0'/></osm>", r":1:\d+: duplicate node id 1"),
-    ("<osm><way><nd ref='1'/></way></osm>", r"<way> without a 'id' attribute"),
+    ("<osm><way><nd ref='1'/></way></osm>", r"<way> without an 'id' attribute"),
 ]
 
 
@@ -390,7 +390,7 @@ def test_cli_info_and_map_option(av2, capsys):
     assert main(["info", str(av2["osm"])]) == 0
     out = capsys.readouterr().out
     doc = av2["doc"]
-    assert "[lanelet2]" in out and f"{len(doc['lane_segments'])} lanes" in out and "1 stop lines" in out
+    assert "[lanelet2]" in out and f"{len(doc['lane_segments'])} lanes" in out and "1 stop line" in out
     assert f"{len(doc['pedestrian_crossings'])} crosswalks" in out
     assert "unknown" not in out
     program = str(REPO / "examples/scenes/s1_pedestrian_in_intersection.scenic")

@@ -100,7 +100,7 @@ def test_spans_do_not_affect_equality():
     [
         ("[[:car:]]{3,1}", "1:10", "minimum above its maximum"),
         ("[@foo([:car:]) > 1]", "1:2", "unknown function @foo"),
-        ("[@x([:car:], [:ped:]) > 1]", "1:2", "@x takes 1 argument(s), not 2"),
+        ("[@x([:car:], [:ped:]) > 1]", "1:2", "@x takes 1 argument, not 2"),
         ("[@x(v) > 1]", "1:5", "variable 'v' is not bound"),
         ("[[:car:] é]", "1:10", "non-ASCII character"),
         ("[[:car:] $ [:ped:]]", "1:10", "unexpected character '$'"),

@@ -176,5 +176,6 @@ def _scenic(args: argparse.Namespace) -> int:
                 f"scenegrep: {count} programs without a road map ({reason}): objects placed without roads",
                 file=sys.stderr,
             )
-        print(f"scenegrep: {len(written)} matches written as Scenic programs to {args.scenic}", file=sys.stderr)
+        what = counted(len(written), "match")
+        print(f"scenegrep: {what} written as Scenic programs to {args.scenic}", file=sys.stderr)
     return 0

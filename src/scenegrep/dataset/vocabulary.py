@@ -61,7 +61,7 @@ def query_warnings(spec: QuerySpec, query: Any, vocabulary: Vocabulary) -> tuple
 
         layers = SPACE_LAYERS[spec.option("space")]
         pairs = [(category, kind) for category, kind, layer in vocabulary.classes if layer in layers]
-        found = unknown_classes(query, pairs)
+        found = unknown_classes(query.tree, query.compat, pairs)
         if spec.option("channels"):
             found += unknown_channels(spec.option("channels"), vocabulary.channels)
         return tuple(found)

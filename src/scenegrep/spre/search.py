@@ -182,7 +182,7 @@ class TraceSearch:
             present = {images.boxes.classes[code] for code in np.unique(images.boxes.category)}
         else:
             present = set(self.trace.objects.category.astype(str).tolist())
-        found = unknown_classes(self.query, [(category, kind_of(category)) for category in present])
+        found = unknown_classes(self.query.tree, self.query.compat, [(c, kind_of(c)) for c in present])
         if self.options.channels and images is not None:
             found += unknown_channels(self.options.channels, images.samples.channels)
         return found

@@ -11,31 +11,28 @@ one warning line naming it and the names the data has.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from typing import TYPE_CHECKING
 
 from ..wording import listed
 from . import syntax as s
 from .requirements import NEVER_REQUIRED
 
-if TYPE_CHECKING:
-    from .search import CompiledQuery
 
-
-def class_names(query: CompiledQuery) -> frozenset[str]:
-    """Every class name the query's class atoms name (``*`` and ``ego`` excepted)."""
-    names = {node.name for node in query.tree.walk() if isinstance(node, s.ClassAtom)}
+def class_names(tree: s.Query) -> frozenset[str]:
+    """Every class name the class atoms of a query's syntax tree name (``*`` and ``ego`` excepted)."""
+    names = {node.name for node in tree.walk() if isinstance(node, s.ClassAtom)}
     return frozenset(names - NEVER_REQUIRED)
 
 
-def unknown_classes(query: CompiledQuery, classes: Iterable[tuple[str, str]]) -> list[str]:
-    """One warning per class name of ``query`` that none of ``classes``, the (class, kind) pairs
-    of the searched traces' objects or boxes, has."""
+def unknown_classes(tree: s.Query, compat: bool, classes: Iterable[tuple[str, str]]) -> list[str]:
+    """One warning per class name of a query (its syntax ``tree``; ``compat``: STREM's mode, where
+    a class atom names a class only, not a kind) that none of ``classes``, the (class, kind)
+    pairs of the searched traces' objects or boxes, has."""
     pairs = set(classes)
     categories = {category for category, _ in pairs}
-    names = categories if query.compat else categories | {kind for _, kind in pairs}
+    names = categories if compat else categories | {kind for _, kind in pairs}
     return [
         f"no trace searched has class {name!r} (classes there: {listed(categories)})"
-        for name in sorted(class_names(query) - names)
+        for name in sorted(class_names(tree) - names)
     ]
 
 

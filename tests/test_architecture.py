@@ -49,7 +49,7 @@ SCENE_LAYERS: tuple[tuple[str, ...], ...] = (
     ("context", "expressions", "specifiers", "lenient_boxes", "resolve", "needs"),  # syntax, specifier semantics
     ("dependencies", "randoms", "evaluate"),  # analysis and evaluation
     ("tolerance", "decide", "solvers"),  # the decision procedures
-    ("match", "query", "explain", "projection", "misses", "profiles"),  # the match driver
+    ("match", "query", "explain", "projection", "misses", "profiles", "vocabulary"),  # the match driver
     ("",),  # scene/__init__: the API
 )
 """Modules (and the ``solvers`` subpackage) of ``scenegrep.scene``, lowest group first (its ``__init__``)."""

@@ -21,7 +21,7 @@ rows of candidate correspondences). *Decision procedures*: :mod:`.tolerance` (pe
 tolerances), :mod:`.decide` (closed forms, else :mod:`.solvers`). *Match driver*: :mod:`.match`
 (Algorithm 1), :mod:`.query` (the API), :mod:`.explain` (witnesses), :mod:`.projection` (values of
 the random variables per match), :mod:`.misses` (nearest misses), :mod:`.profiles` (named
-tolerances).
+tolerances), :mod:`.vocabulary` (program objects no searched trace has an object of the kinds of).
 """
 
 from .tolerance import Tolerance

@@ -186,7 +186,7 @@ def _contains(r: Context, node: ir.Compare, thing: Any, region: Any) -> Term:
 
 
 def EXACT(r: Context) -> Term:  # noqa: N802 - a constant
-    """The 'ease' argument of a box predicate before :func:`.tolerance.eased` sets it (0: exact)."""
+    """The 'ease' argument of a box predicate before :func:`.lenient_boxes.eased` sets it (0: exact)."""
     return r.f.const(0)
 
 

@@ -33,6 +33,27 @@ class Unsupported(ValueError):
     one that is malformed (the generic walk names the fault)."""
 
 
+@dataclass(frozen=True)
+class _Spots:
+    """Where one field is in every item of a level: ``k`` values of ``dtype`` at each CDR offset
+    ``at``; ``step`` the constant step between the offsets (None when uneven), ``columns`` the
+    byte offsets of all the values (for a gather)."""
+
+    dtype: str
+    k: int
+    at: np.ndarray
+    step: int | None
+    columns: np.ndarray
+
+    @classmethod
+    def of(cls, dtype: str, k: int, at: list[int]) -> _Spots:
+        spots = np.array(at, dtype=np.int64)
+        step = int(spots[1] - spots[0]) if len(spots) > 1 else 0
+        even = len(spots) > 0 and np.array_equal(spots, spots[0] + step * np.arange(len(spots)))
+        columns = (spots[:, None] + np.arange(np.dtype(dtype).itemsize * k)).ravel()
+        return cls(dtype, k, spots, step if even else None, columns)
+
+
 @dataclass
 class _LevelPlan:
     """One level of a layout: per item its parent item and rank; per wanted primitive field its
@@ -44,6 +65,7 @@ class _LevelPlan:
     rank: list[int] = field(default_factory=list)
     fields: dict[str, tuple[str, int, list[int]]] = field(default_factory=dict)
     strings: dict[str, tuple[list[int], list[int]]] = field(default_factory=dict)
+    spots: dict[str, _Spots] = field(default_factory=dict)
 
 
 @dataclass
@@ -53,7 +75,7 @@ class Layout:
     values, ``levels`` the items and fields (offsets from the CDR origin)."""
 
     size: int
-    count_at: np.ndarray
+    count_at: _Spots
     count_value: np.ndarray
     levels: dict[str, _LevelPlan]
 
@@ -122,7 +144,9 @@ def layout(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozense
         return pos
 
     walk(type_name, "", "", 0, 0)
-    at = np.array([c[0] for c in counts], dtype=np.int64)
+    for plan in levels.values():
+        plan.spots = {path: _Spots.of(*spec) for path, spec in plan.fields.items()}
+    at = _Spots.of("<u4", 1, [c[0] for c in counts])
     return Layout(len(raw), at, np.array([c[1] for c in counts], dtype=np.uint32), levels)
 
 
@@ -168,22 +192,21 @@ def _groups(payloads: Sequence) -> list[_Group] | None:
     return groups
 
 
-def _values(group: _Group, at: np.ndarray, dtype: str, k: int) -> np.ndarray:
-    """Per message of ``group``, ``k`` values of ``dtype`` at each of the CDR offsets ``at``:
-    shape (messages, len(at), k); one strided view where the places are evenly spaced."""
-    size = np.dtype(dtype).itemsize
-    n, spots = len(group.origins), len(at)
-    step = int(at[1] - at[0]) if spots > 1 else 0
-    if group.stride is not None and spots and np.array_equal(at, at[0] + step * np.arange(spots)):
-        strides = (group.stride, step, size)
-        return np.ndarray((n, spots, k), dtype, group.base, int(group.origins[0] + at[0]), strides).copy()
-    columns = (at[:, None] + np.arange(size * k)).ravel()
-    return group.base[group.origins[:, None] + columns].view(dtype).reshape(n, spots, k)
+def _values(group: _Group, spots: _Spots) -> np.ndarray:
+    """Per message of ``group``, the field at ``spots``: shape (messages, spots, k); a strided
+    view of the group's buffer where the places are evenly spaced, else a gathered copy."""
+    n, m = len(group.origins), len(spots.at)
+    if group.stride is not None and spots.step is not None:
+        strides = (group.stride, spots.step, np.dtype(spots.dtype).itemsize)
+        return np.ndarray((n, m, spots.k), spots.dtype, group.base, int(group.origins[0] + spots.at[0]), strides)
+    return group.base[group.origins[:, None] + spots.columns].view(spots.dtype).reshape(n, m, spots.k)
 
 
 def matches(plan: Layout, groups: list[_Group]) -> bool:
     """Whether every message of ``groups`` (all of the plan's size) has the layout ``plan``."""
-    return all((_values(g, plan.count_at, "<u4", 1)[:, :, 0] == plan.count_value).all() for g in groups)
+    if not len(plan.count_at.at):
+        return True
+    return all((_values(g, plan.count_at)[:, :, 0] == plan.count_value).all() for g in groups)
 
 
 def _strings(groups: list[_Group], at: list[int], lengths: list[int]) -> np.ndarray:
@@ -195,7 +218,8 @@ def _strings(groups: list[_Group], at: list[int], lengths: list[int]) -> np.ndar
         if not length:
             texts[j::m] = ""
             continue
-        raw = np.concatenate([_values(g, np.array([pos]), f"V{length}", 1).ravel() for g in groups])
+        spots = _Spots.of(f"V{length}", 1, [pos])
+        raw = np.concatenate([_values(g, spots).ravel() for g in groups])
         unique, inverse = np.unique(raw, return_inverse=True)
         decoded = np.array([bytes(u).rstrip(b"\0").decode("utf-8", "replace") for u in unique], dtype=object)
         texts[j::m] = decoded[inverse.ravel()]
@@ -204,22 +228,17 @@ def _strings(groups: list[_Group], at: list[int], lengths: list[int]) -> np.ndar
 
 def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level]:
     """The levels of the messages of ``groups`` (every one of layout ``plan``: check
-    :func:`matches` first), in message order. Every field of a group is read before the next
-    group (its chunk is then still in cache)."""
+    :func:`matches` first), in message order. Every field of a group is copied out before the
+    next group is read (its chunk is then still in cache)."""
     n = sum(len(g.origins) for g in groups)
-    spots = {
-        (name, path): np.array(at, dtype=np.int64)
-        for name, p in plan.levels.items()
-        for path, (_, _, at) in p.fields.items()
-    }
-    parts = [
-        {
-            (name, path): _values(g, spots[name, path], dtype, k)
-            for name, p in plan.levels.items()
-            for path, (dtype, k, _) in p.fields.items()
-        }
-        for g in groups
-    ]
+    wanted = [(name, path, spots) for name, p in plan.levels.items() for path, spots in p.spots.items()]
+    columns = {(name, path): np.empty((n, len(s.at), s.k), s.dtype) for name, path, s in wanted}
+    start = 0
+    for g in groups:
+        end = start + len(g.origins)
+        for name, path, spots in wanted:
+            columns[name, path][start:end] = _values(g, spots)
+        start = end
     sizes = {name: len(p.parent) for name, p in plan.levels.items()}
     out: dict[str, Level] = {}
     for name, p in plan.levels.items():
@@ -229,9 +248,9 @@ def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level]:
         if name:
             parent = message * sizes[p.parent_level] + np.tile(np.array(p.parent, dtype=np.int64), n)
         fields: dict[str, np.ndarray] = {}
-        for path, (_, k, _) in p.fields.items():
-            values = np.concatenate([part[name, path] for part in parts])
-            fields[path] = values.reshape(n * m) if k == 1 else values.reshape(n * m, k)
+        for path, spots in p.spots.items():
+            values = columns[name, path]
+            fields[path] = values.reshape(n * m) if spots.k == 1 else values.reshape(n * m, spots.k)
         for path, (at, lengths) in p.strings.items():
             fields[path] = _strings(groups, at, lengths)
         out[name] = Level(parent, np.tile(np.array(p.rank, dtype=np.int64), n), fields)

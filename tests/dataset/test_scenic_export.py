@@ -243,7 +243,7 @@ def test_cli_refuses_bad_options_and_targets(tmp_path, capsys):
         assert code == 2 and message in err and "Traceback" not in err, (bad, err)
     code, err = run(["export", results, "--scenic", tmp_path / "o", "--context", "3"], capsys)
     assert code == 0 and "1 match written as Scenic programs" in err
-    assert "1 programs without a road map (the trace has no road map)" in err
+    assert "1 program without a road map (the trace has no road map)" in err
     (program,) = (tmp_path / "o").iterdir()
     assert program.name == "walk-0.scenic" and "with name 'c'" in program.read_text()  # c: 2 m from w
 

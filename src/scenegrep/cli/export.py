@@ -77,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
 
     count = write_mcap_events(Results.read(args.results), args.mcap)
     if not args.quiet:
-        print(f"scenegrep: {count} matches written as Foxglove events to {args.mcap}", file=sys.stderr)
+        print(f"scenegrep: {counted(count, 'match')} written as Foxglove events to {args.mcap}", file=sys.stderr)
     return 0
 
 
@@ -97,7 +97,8 @@ def _refav(args: argparse.Namespace) -> int:
         positive = sum(any(len(f.label) for f in frames) for frames in sequences.values())
         frames = sum(len(frames) for frames in sequences.values())
         print(
-            f"scenegrep: {len(sequences)} logs ({positive} with a referred track), {frames} evaluation timestamps "
+            f"scenegrep: {counted(len(sequences), 'log')} ({positive} with a referred track), "
+            f"{counted(frames, 'evaluation timestamp')} "
             f"written to {args.refav}",
             file=sys.stderr,
         )
@@ -173,7 +174,7 @@ def _scenic(args: argparse.Namespace) -> int:
         for reason in sorted({w.without_map for w in written if w.without_map}):
             count = sum(w.without_map == reason for w in written)
             print(
-                f"scenegrep: {count} programs without a road map ({reason}): objects placed without roads",
+                f"scenegrep: {counted(count, 'program')} without a road map ({reason}): objects placed without roads",
                 file=sys.stderr,
             )
         what = counted(len(written), "match")

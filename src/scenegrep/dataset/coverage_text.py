@@ -30,7 +30,7 @@ def summary_text(coverage: Coverage, program: str) -> str:
         lines.append(f"{axis.name} (line {axis.declared.line}): {axis.domain_text()}")
         lines.append("  " + "  ".join(f"{axis.label(k)} {n}" for k, n in enumerate(counts)))
         lines.append(
-            f"  covered {covered} of {axis.bins} bins by {sum(counts)} matches; "
+            f"  covered {covered} of {counted(axis.bins, 'bin')} by {counted(sum(counts), 'match')}; "
             f"ambiguous {int((column == AMBIGUOUS).sum())}; without a value {int((column == NO_VALUE).sum())}"
         )
         gaps = [axis.label(k) for k, n in enumerate(counts) if not n]

@@ -19,6 +19,7 @@ from ..writers.atomic import atomic_path
 from .charts import bar_chart, histogram
 from .page import asset, html_page, view_page
 from .sources import ResultsSource
+from ..wording import counted
 
 MOST_BARS = 40
 """The matches-per-trace chart shows the traces with the most matches, at most this many."""
@@ -97,7 +98,7 @@ def _charts(rows: list[dict[str, Any]], matches: list[dict[str, Any]], kinds: di
             [name for name, _ in top],
             [[n for _, n in top]],
             ["matches"],
-            f"Matches per trace ({len(per_trace)} traces with a match"
+            f"Matches per trace ({counted(len(per_trace), 'trace')} with a match"
             + (f"; the {MOST_BARS} with the most)" if len(per_trace) > MOST_BARS else ")"),
             "chart-matches",
         ),

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UserError, nearest
+from ..wording import counted
 
 LISTED = 10
 """An unknown name lists the table's traces up to this many, else the nearest names."""
@@ -99,8 +100,8 @@ def _listing(traces: list[_Trace], given: str) -> str:
         return "traces: " + ", ".join(f"{t.name} ({t.trace_id})" for t in traces)
     near = nearest(given, sorted({name for t in traces for name in (t.name, t.trace_id)}))
     if not near:
-        return f"none of its {len(traces)} traces has a near name"
-    return f"nearest of its {len(traces)} traces: {', '.join(near)}"
+        return f"none of its {counted(len(traces), 'trace')} has a near name"
+    return f"nearest of its {counted(len(traces), 'trace')}: {', '.join(near)}"
 
 
 def _same_file(path: str, source: str) -> bool:

@@ -21,7 +21,7 @@ from mcap.writer import CompressionType, Writer
 from scenegrep import readers
 from scenegrep.errors import UserError
 from scenegrep.readers.ros.cdr import Payloads, decode
-from scenegrep.readers.ros.cdr_layout import Unsupported, decode_same_layout, layout
+from scenegrep.readers.ros.cdr_layout import Unsupported, _Spots, decode_same_layout, layout
 from scenegrep.readers.ros.chunks import mcap_messages
 from scenegrep.readers.ros.decoders import _DECODERS, decode_batch, type_key, types_of
 
@@ -164,3 +164,14 @@ def test_a_message_of_the_same_size_and_another_count_is_read_as_the_generic_wal
     trace = readers.read_trace(path, "ros-bag")
     per_frame = np.bincount(trace.states.frame, minlength=trace.n_frames)
     assert per_frame.tolist() == [3] * 17 + [2] + [3] * 12
+
+
+@given(st.lists(st.integers(1, 40), max_size=30))
+def test_runs_of_evenly_spaced_places_give_back_every_place(gaps):
+    at = np.cumsum([0, *gaps]).tolist()
+    spots = _Spots.of("<f8", 1, at)
+    assert spots.columns.tolist() == [a + b for a in at for b in range(8)]
+    if spots.runs is None:
+        return
+    rebuilt = [at[start] + j * step for start, count, step in spots.runs for j in range(count)]
+    assert rebuilt == at and sum(count for _, count, _ in spots.runs) == len(at)

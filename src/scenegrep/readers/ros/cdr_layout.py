@@ -36,22 +36,35 @@ class Unsupported(ValueError):
 @dataclass(frozen=True)
 class _Spots:
     """Where one field is in every item of a level: ``k`` values of ``dtype`` at each CDR offset
-    ``at``; ``step`` the constant step between the offsets (None when uneven), ``columns`` the
-    byte offsets of all the values (for a gather)."""
+    ``at``. Items of one size are evenly spaced, items of other sizes (a longer string) break
+    that into runs: ``runs`` are (first item, items, step) of evenly spaced offsets, None when
+    there are more than :data:`MAX_RUNS` (then ``columns``, the byte offsets of all the values,
+    are gathered)."""
 
     dtype: str
     k: int
     at: np.ndarray
-    step: int | None
+    runs: tuple[tuple[int, int, int], ...] | None
     columns: np.ndarray
 
     @classmethod
     def of(cls, dtype: str, k: int, at: list[int]) -> _Spots:
         spots = np.array(at, dtype=np.int64)
-        step = int(spots[1] - spots[0]) if len(spots) > 1 else 0
-        even = len(spots) > 0 and np.array_equal(spots, spots[0] + step * np.arange(len(spots)))
         columns = (spots[:, None] + np.arange(np.dtype(dtype).itemsize * k)).ravel()
-        return cls(dtype, k, spots, step if even else None, columns)
+        runs: list[tuple[int, int, int]] = []
+        start = 0
+        while start < len(spots):
+            step = int(spots[start + 1] - spots[start]) if start + 1 < len(spots) else 0
+            end = start + 1
+            while end < len(spots) and spots[end] - spots[end - 1] == step:
+                end += 1
+            runs.append((start, end - start, step))
+            start = end
+        return cls(dtype, k, spots, tuple(runs) if len(runs) <= MAX_RUNS else None, columns)
+
+
+MAX_RUNS = 8
+"""The most runs of evenly spaced places read as strided views (more are gathered)."""
 
 
 @dataclass
@@ -192,21 +205,31 @@ def _groups(payloads: Sequence) -> list[_Group] | None:
     return groups
 
 
-def _values(group: _Group, spots: _Spots) -> np.ndarray:
-    """Per message of ``group``, the field at ``spots``: shape (messages, spots, k); a strided
-    view of the group's buffer where the places are evenly spaced, else a gathered copy."""
+def _values(group: _Group, spots: _Spots, out: np.ndarray) -> np.ndarray:
+    """Per message of ``group``, the field at ``spots``, written into ``out`` (shape (messages,
+    spots, k)) and returned: one strided view of the group's buffer per run of evenly spaced
+    places (:class:`_Spots`) when the group's messages are evenly spaced, else one gather."""
     n, m = len(group.origins), len(spots.at)
-    if group.stride is not None and spots.step is not None:
-        strides = (group.stride, spots.step, np.dtype(spots.dtype).itemsize)
-        return np.ndarray((n, m, spots.k), spots.dtype, group.base, int(group.origins[0] + spots.at[0]), strides)
-    return group.base[group.origins[:, None] + spots.columns].view(spots.dtype).reshape(n, m, spots.k)
+    if group.stride is not None and spots.runs is not None:
+        size, first = np.dtype(spots.dtype).itemsize, int(group.origins[0])
+        for start, count, step in spots.runs:
+            at = first + int(spots.at[start])
+            view = np.ndarray((n, count, spots.k), spots.dtype, group.base, at, (group.stride, step, size))
+            out[:, start : start + count] = view
+        return out
+    out[...] = group.base[group.origins[:, None] + spots.columns].view(spots.dtype).reshape(n, m, spots.k)
+    return out
 
 
 def matches(plan: Layout, groups: list[_Group]) -> bool:
     """Whether every message of ``groups`` (all of the plan's size) has the layout ``plan``."""
     if not len(plan.count_at.at):
         return True
-    return all((_values(g, plan.count_at)[:, :, 0] == plan.count_value).all() for g in groups)
+    counts = plan.count_at
+    return all(
+        (_values(g, counts, np.empty((len(g.origins), len(counts.at), 1), "<u4"))[:, :, 0] == plan.count_value).all()
+        for g in groups
+    )
 
 
 def _strings(groups: list[_Group], at: list[int], lengths: list[int]) -> np.ndarray:
@@ -219,7 +242,7 @@ def _strings(groups: list[_Group], at: list[int], lengths: list[int]) -> np.ndar
             texts[j::m] = ""
             continue
         spots = _Spots.of(f"V{length}", 1, [pos])
-        raw = np.concatenate([_values(g, spots).ravel() for g in groups])
+        raw = np.concatenate([_values(g, spots, np.empty((len(g.origins), 1, 1), spots.dtype)).ravel() for g in groups])
         unique, inverse = np.unique(raw, return_inverse=True)
         decoded = np.array([bytes(u).rstrip(b"\0").decode("utf-8", "replace") for u in unique], dtype=object)
         texts[j::m] = decoded[inverse.ravel()]
@@ -237,7 +260,7 @@ def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level]:
     for g in groups:
         end = start + len(g.origins)
         for name, path, spots in wanted:
-            columns[name, path][start:end] = _values(g, spots)
+            _values(g, spots, columns[name, path][start:end])
         start = end
     sizes = {name: len(p.parent) for name, p in plan.levels.items()}
     out: dict[str, Level] = {}

@@ -78,7 +78,7 @@ class _LevelPlan:
     rank: list[int] = field(default_factory=list)
     fields: dict[str, tuple[str, int, list[int]]] = field(default_factory=dict)
     strings: dict[str, tuple[list[int], list[int]]] = field(default_factory=dict)
-    spots: dict[str, _Spots] = field(default_factory=dict)
+    blocks: list[tuple[tuple[str, ...], _Spots]] = field(default_factory=list)
 
 
 @dataclass
@@ -158,9 +158,29 @@ def layout(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozense
 
     walk(type_name, "", "", 0, 0)
     for plan in levels.values():
-        plan.spots = {path: _Spots.of(*spec) for path, spec in plan.fields.items()}
+        plan.blocks = _blocks(plan.fields)
     at = _Spots.of("<u4", 1, [c[0] for c in counts])
     return Layout(len(raw), at, np.array([c[1] for c in counts], dtype=np.uint32), levels)
+
+
+def _blocks(fields: dict[str, tuple[str, int, list[int]]]) -> list[tuple[tuple[str, ...], _Spots]]:
+    """The wanted fields of a level as blocks read at once: single values of one type that
+    follow each other without a gap in every item (a point's x, y, z) are one block of k values;
+    any other field is a block of its own."""
+    order = sorted(fields.items(), key=lambda item: item[1][2][0])
+    blocks = []
+    i = 0
+    while i < len(order):
+        path, (dtype, k, at) = order[i]
+        paths, size = [path], np.dtype(dtype).itemsize
+        while k == 1 and i + len(paths) < len(order):
+            _, (other, count, places) = order[i + len(paths)]
+            if other != dtype or count != 1 or any(b != a + size * len(paths) for a, b in zip(at, places)):
+                break
+            paths.append(order[i + len(paths)][0])
+        blocks.append((tuple(paths), _Spots.of(dtype, len(paths) if k == 1 else k, at)))
+        i += len(paths)
+    return blocks
 
 
 @dataclass(frozen=True)
@@ -251,16 +271,16 @@ def _strings(groups: list[_Group], at: list[int], lengths: list[int]) -> np.ndar
 
 def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level]:
     """The levels of the messages of ``groups`` (every one of layout ``plan``: check
-    :func:`matches` first), in message order. Every field of a group is copied out before the
-    next group is read (its chunk is then still in cache)."""
+    :func:`matches` first), in message order. Every block of fields of a group is copied out
+    before the next group is read (its chunk is then still in cache)."""
     n = sum(len(g.origins) for g in groups)
-    wanted = [(name, path, spots) for name, p in plan.levels.items() for path, spots in p.spots.items()]
-    columns = {(name, path): np.empty((n, len(s.at), s.k), s.dtype) for name, path, s in wanted}
+    wanted = [(name, paths, spots) for name, p in plan.levels.items() for paths, spots in p.blocks]
+    columns = {(name, paths): np.empty((n, len(s.at), s.k), s.dtype) for name, paths, s in wanted}
     start = 0
     for g in groups:
         end = start + len(g.origins)
-        for name, path, spots in wanted:
-            _values(g, spots, columns[name, path][start:end])
+        for name, paths, spots in wanted:
+            _values(g, spots, columns[name, paths][start:end])
         start = end
     sizes = {name: len(p.parent) for name, p in plan.levels.items()}
     out: dict[str, Level] = {}
@@ -271,9 +291,12 @@ def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level]:
         if name:
             parent = message * sizes[p.parent_level] + np.tile(np.array(p.parent, dtype=np.int64), n)
         fields: dict[str, np.ndarray] = {}
-        for path, spots in p.spots.items():
-            values = columns[name, path]
-            fields[path] = values.reshape(n * m) if spots.k == 1 else values.reshape(n * m, spots.k)
+        for paths, spots in p.blocks:
+            values = columns[name, paths]
+            if len(paths) == 1:
+                fields[paths[0]] = values.reshape(n * m) if spots.k == 1 else values.reshape(n * m, spots.k)
+            else:
+                fields.update((path, values[:, :, j].reshape(n * m)) for j, path in enumerate(paths))
         for path, (at, lengths) in p.strings.items():
             fields[path] = _strings(groups, at, lengths)
         out[name] = Level(parent, np.tile(np.array(p.rank, dtype=np.int64), n), fields)

@@ -77,7 +77,11 @@ def _frames(names: np.ndarray) -> np.ndarray:
 
 
 def _ordered(level: Level) -> np.ndarray:
-    """The rows of a level in message order (by parent, then position in the sequence)."""
+    """The rows of a level in message order (by parent, then position in the sequence); no sort
+    when they are in that order already (a batch of one layout is decoded in it)."""
+    parent, rank = np.diff(level.parent), np.diff(level.rank)
+    if ((parent > 0) | ((parent == 0) & (rank > 0))).all():
+        return np.arange(len(level.parent))
     return np.lexsort((level.rank, level.parent))
 
 
@@ -119,14 +123,19 @@ def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:
 
 def _uuid_text(raw: np.ndarray) -> np.ndarray:
     """Canonical UUID strings of (n, 16) bytes (formatted once per distinct UUID)."""
-    unique, inverse = np.unique(np.ascontiguousarray(raw).view("V16").ravel(), return_inverse=True)
+    words = np.ascontiguousarray(raw, dtype=np.uint8).view("<u8").reshape(len(raw), 2)
+    order = np.lexsort((words[:, 1], words[:, 0]))
+    ordered = words[order]
+    new = np.r_[True, (ordered[1:] != ordered[:-1]).any(axis=1)] if len(raw) else np.zeros(0, bool)
+    inverse = np.empty(len(raw), dtype=np.int64)
+    inverse[order] = np.cumsum(new) - 1
     texts = []
-    for value in unique:
+    for value in raw[order[new]]:
         h = bytes(value).hex()
         texts.append(f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:]}")
-    out = np.empty(len(unique), dtype=object)
+    out = np.empty(len(texts), dtype=object)
     out[:] = texts
-    return out[inverse.ravel()]
+    return out[inverse]
 
 
 def _autoware(tracked: bool) -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:

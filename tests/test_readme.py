@@ -13,7 +13,7 @@ README = (REPO / "README.md").read_text()
 
 def quick_start() -> list[str]:
     section = README.split("## Quick start", 1)[1].split("\n## ", 1)[0]
-    return re.findall(r"```\n(.+?)\n```", section)
+    return re.findall(r"```console\n\$ (.+?)\n```", section)
 
 
 def test_two_quick_start_commands():

@@ -10,7 +10,10 @@
 - ``examples/stream.json``: a STREM JSON v0.2.0 stream of 60 frames (6 s at 10 Hz): the boxes a
   pinhole front camera on the ego (1600 x 900 px, focal length 1000 px, 1.5 m above the ground)
   sees in one simulated run of ``examples/make/street.scenic`` (Scenic's Newtonian simulator,
-  seed 0): the car ahead (class ``car``) and a pedestrian walking ahead (``pedestrian``).
+  seed 0): the car ahead (class ``car``) and a pedestrian walking ahead (``pedestrian``);
+- ``examples/stream.mcap`` and ``examples/trace.mcap``: the same as MCAP files, one JSON document
+  per frame and message (schemas ``strem/Document`` and ``scenegrep/Trace``, topics ``/camera``
+  and ``/trace``, frames 0.1 s apart), what ``--follow`` reads while a recorder writes it.
 
 Run from the repository root: ``python examples/make/make_examples.py`` (Scenic is needed for
 the last two). The same Scenic version and seeds give the same files.
@@ -38,15 +41,15 @@ WIDTH, HEIGHT, FOCAL, CAMERA_HEIGHT = 1600, 900, 1000.0, 1.5
 MAX_DEPTH = 30.0
 
 
-def write_trace_and_map() -> None:
-    """``trace.json`` (frames 0-29 of a sample trace, no map entry) and ``map.parquet``."""
+def write_trace_and_map(out: Path = EXAMPLES) -> None:
+    """``trace.json`` (frames 0-29 of a sample trace, no map entry) and ``map.parquet`` in ``out``."""
     trace = readers.read_trace(EXAMPLES / "sample" / "fig1_lane_change-000.parquet").slice_frames(0, 30)
     road_map = readers.read_map(trace.map_source)
     x, y = trace.states.x, trace.states.y
     centre = ((x.min() + x.max()) / 2, (y.min() + y.max()) / 2)
-    write_map_parquet(road_map.crop(*centre, 150.0), EXAMPLES / "map.parquet")
+    write_map_parquet(road_map.crop(*centre, 150.0), out / "map.parquet")
     document = trace_document(replace(trace, name="trace", map_source=None))
-    (EXAMPLES / "trace.json").write_text(json.dumps(document, separators=(",", ":")) + "\n")
+    (out / "trace.json").write_text(json.dumps(document, separators=(",", ":")) + "\n")
 
 
 def write_scenes() -> None:
@@ -105,8 +108,34 @@ def write_stream() -> None:
     (EXAMPLES / "stream.json").write_text(text + "\n")
 
 
+def write_mcap(path: Path, topic: str, schema: str, documents: list[dict]) -> None:
+    """``documents`` as the JSON messages of one MCAP channel, 0.1 s apart."""
+    from mcap.writer import Writer
+
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        writer.start("", "scenegrep examples")
+        channel = writer.register_channel(topic, "json", writer.register_schema(schema, "jsonschema", b""))
+        for k, document in enumerate(documents):
+            data = json.dumps(document, separators=(",", ":")).encode()
+            writer.add_message(channel, log_time=k * 100_000_000, data=data, publish_time=k * 100_000_000)
+        writer.finish()
+
+
+def write_mcaps(out: Path = EXAMPLES) -> None:
+    """``stream.mcap`` (``examples/stream.json``'s frames) and ``trace.mcap`` (``examples/trace.json``'s
+    frames) in ``out``."""
+    stream = json.loads((EXAMPLES / "stream.json").read_text())
+    frames = [{"version": stream["version"], "frames": [frame]} for frame in stream["frames"]]
+    write_mcap(out / "stream.mcap", "/camera", "strem/Document", frames)
+    trace = readers.read_trace(EXAMPLES / "trace.json")
+    documents = [trace_document(trace.slice_frames(f, f + 1)) for f in range(trace.n_frames)]
+    write_mcap(out / "trace.mcap", "/trace", "scenegrep/Trace", documents)
+
+
 if __name__ == "__main__":
     write_trace_and_map()
     if "--no-scenic" not in sys.argv:
         write_scenes()
         write_stream()
+    write_mcaps()

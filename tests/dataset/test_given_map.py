@@ -91,4 +91,4 @@ def test_ingest_gives_traces_without_a_map_the_given_one_and_queries_over_the_da
     shutil.copy(folder / "Town06.xodr", other)
     other.write_bytes(other.read_bytes() + b"\n")
     assert main(["ingest", str(data), "--into", fleet, "-j", "1", "--map", str(other)]) == 0
-    assert "1 sources ingested (1 traces), 0 unchanged" in lines(capsys)[1][-1]
+    assert "1 source ingested (1 trace), 0 unchanged" in lines(capsys)[1][-1]

@@ -19,6 +19,7 @@ A batch that is not of one layout, or holds a bad header, or a type this module 
 from __future__ import annotations
 
 import struct
+from operator import attrgetter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -200,25 +201,30 @@ def _group(base: np.ndarray, origins: np.ndarray) -> _Group:
     return _Group(base, origins, stride)
 
 
+def _address(buffer) -> int:
+    """The memory address of a buffer's first byte."""
+    return np.frombuffer(buffer, np.uint8).__array_interface__["data"][0]
+
+
 def _groups(payloads: Sequence) -> list[_Group] | None:
     """The batch as runs of messages sharing one buffer (memoryviews of one chunk; bytes are
     copied into one buffer), or None when the payloads' sizes differ or one lacks the
     little-endian CDR encapsulation header."""
     size = len(payloads[0])
-    if size < HEADER or any(len(p) != size for p in payloads):
+    if size < HEADER or set(map(len, payloads)) != {size}:
         return None
-    if not all(isinstance(p, memoryview) for p in payloads):
+    if set(map(type, payloads)) != {memoryview}:
         base = np.frombuffer(b"".join(payloads), dtype=np.uint8)
         groups = [_group(base, np.arange(len(payloads), dtype=np.int64) * size + HEADER)]
     else:
-        owners = [p.obj for p in payloads]
-        cuts = [0, *(i for i in range(1, len(owners)) if owners[i] is not owners[i - 1]), len(owners)]
+        owners = list(map(attrgetter("obj"), payloads))
+        same = np.fromiter(map(id, owners), np.int64, len(owners))  # (all alive: ids are distinct)
+        cuts = [0, *(np.flatnonzero(same[1:] != same[:-1]) + 1).tolist(), len(owners)]
+        address = np.fromiter(map(_address, payloads), np.int64, len(payloads))
         groups = []
         for start, end in zip(cuts, cuts[1:]):
             base = np.frombuffer(owners[start], dtype=np.uint8)
-            origin = base.__array_interface__["data"][0] - HEADER
-            at = [np.frombuffer(p, np.uint8).__array_interface__["data"][0] - origin for p in payloads[start:end]]
-            groups.append(_group(base, np.array(at, dtype=np.int64)))
+            groups.append(_group(base, address[start:end] - _address(base) + HEADER))
     for g in groups:
         if (g.base[g.origins - HEADER] != 0).any() or (g.base[g.origins - HEADER + 1] != 1).any():
             return None

@@ -14,6 +14,7 @@ from scenegrep.cli.main import main
 from scenegrep.errors import UserError
 from scenegrep.model import LabelTrace, TraceSource, concatenate
 from scenegrep.model.geometry import heading_difference
+from scenegrep.model.trace import EGO_SIZE_UNKNOWN
 from scenegrep.readers.ros.bag import bag_messages
 from scenegrep.readers.ros.framing import FrameBuilder
 from scenegrep.readers.ros.options import BagOptions
@@ -44,10 +45,12 @@ def assert_same(
     frames: np.ndarray | None = None,
     id_of=read_back_id,
     velocity: bool = True,
+    ego_size: bool = False,
 ) -> None:
     """``bag`` holds ``original``'s frames (all, or the positions ``frames``): the same objects
     (``id_of``: the id the bag gives an original id), kinds, positions (1e-6 m), headings, sizes
-    and velocities (unless the messages carry none: ``velocity``; the ego's pose only), times."""
+    and velocities (unless the messages carry none: ``velocity``; the ego's pose only, and its
+    size when the reader was given it: ``ego_size``, else unknown and said so), times."""
     if frames is not None:
         keep = np.zeros(original.n_frames, dtype=bool)
         keep[frames] = True
@@ -75,10 +78,13 @@ def assert_same(
     assert np.abs(heading_difference(b.heading, s.heading[order])).max() < 1e-9
     not_ego = b.object != rows["ego"]
     for column in ("length", "width", "height", "vx", "vy")[: 5 if velocity else 3]:
+        compared = np.ones(len(b), bool) if ego_size and column in ("length", "width", "height") else not_ego
         np.testing.assert_allclose(
-            getattr(b, column)[not_ego], getattr(s, column)[order][not_ego], rtol=0, atol=1e-6, equal_nan=True
+            getattr(b, column)[compared], getattr(s, column)[order][compared], rtol=0, atol=1e-6, equal_nan=True
         )
-    assert np.isnan(b.length[~not_ego]).all()  # /tf carries no ego size
+    if not ego_size:  # /tf carries no ego size
+        assert np.isnan(b.length[~not_ego]).all() and "--ego-size" in bag.attributes[EGO_SIZE_UNKNOWN]
+    assert (EGO_SIZE_UNKNOWN in bag.attributes) != ego_size
     if not velocity:
         assert np.isnan(b.vx).all()
 
@@ -89,6 +95,35 @@ def test_tracked_objects_and_tf_give_back_the_trace(av2):
     assert readers.detect_format(path) == "ros-bag"
     assert bag.ego == "ego" and bag.attributes["time_origin_ns"] == ORIGIN
     assert_same(trace, bag)
+
+
+def test_given_the_ego_size_the_ego_comes_back_whole(av2):
+    """With ``ego_size`` (``--ego-size``) the AV2 ego's recorded size comes back too (AV2 gives
+    one size to the ego: read from the log's own rows), and the trace no longer says it is unknown."""
+    trace, path = av2
+    ego = trace.states.object == trace.object_index(trace.ego)
+    size = tuple(float(np.unique(getattr(trace.states, c)[ego]).item()) for c in ("length", "width", "height"))
+    assert_same(trace, read_trace(path, BagOptions(ego_size=size)), ego_size=True)
+
+
+@pytest.mark.parametrize(
+    ("given", "reason"),
+    [
+        ("0,1.9,1.5", "three lengths over 0"),
+        ("-4.9,1.9,1.5", "three lengths over 0"),
+        ("nan,1.9,1.5", "three lengths over 0"),
+        ("inf,1.9,1.5", "three lengths over 0"),
+        ("4.9,1.9,101", "at most 100 m"),
+        ("4.9,1.9", "LENGTH,WIDTH,HEIGHT"),
+        ("4.9,1.9,1.5,1", "LENGTH,WIDTH,HEIGHT"),
+        ("4.9,wide,1.5", "LENGTH,WIDTH,HEIGHT in metres"),
+        ("", "LENGTH,WIDTH,HEIGHT"),
+    ],
+)
+def test_a_bad_ego_size_is_one_line(av2, given, reason, capsys):
+    assert main(["info", str(av2[1]), f"--ego-size={given}"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("scenegrep: error: --ego-size") and reason in err and err.count("\n") == 1
 
 
 @pytest.mark.slow
@@ -235,7 +270,8 @@ def test_info_lists_topics_and_the_options_reach_the_reader(av2, capsys):
 def test_bag_options_with_a_dataset_are_refused_not_ignored(command, tmp_path, capsys):
     """A dataset's traces were read from their bags at ingest: options that change how bags are
     read cannot apply to them, so they are an error, not silently dropped; the defaults are fine."""
-    for option in (["--rate", "2"], ["--frame-topic", TOPIC], ["--topics", TOPIC], ["--ego-frame", "none"]):
+    options = (["--rate", "2"], ["--frame-topic", TOPIC], ["--topics", TOPIC], ["--ego-frame", "none"])
+    for option in (*options, ["--ego-size", "4.9,1.9,1.5"]):
         assert main([*command, "--dataset", str(tmp_path), *option]) == 2
         assert "a dataset's traces were read at ingest" in capsys.readouterr().err
     assert main([*command, "--dataset", str(tmp_path), "--map-frame", "map"]) == 2  # no program, no catalog

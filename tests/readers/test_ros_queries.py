@@ -3,7 +3,9 @@
 The AV2 log 7fab2350 is written as TrackedObjects, vision_msgs Detection3DArray or Foxglove
 SceneUpdate cubes, with /tf (:mod:`.ros_writer`); the trace compared is the log as those
 messages can carry it: classes as Autoware labels (TrackedObjects), no velocity (the others),
-no ego size or velocity (``/tf`` carries neither), the bag's attributes. Both are queried through the command line with
+no ego velocity (``/tf`` carries none), the bag's attributes. ``/tf`` carries no ego size either:
+the bag is queried with ``--ego-size`` (the log's own ego size); without it, a query that needs
+the ego's extent is an error naming the option. Both are queried through the command line with
 the log's own map, and their match rows must be equal.
 """
 
@@ -16,9 +18,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from scenegrep import readers
 from scenegrep.cli.main import main
 from scenegrep.model import ObjectTable
+from scenegrep.readers.ros.options import BagOptions
+from scenegrep.readers.ros.reader import read_trace as read_bag
 from scenegrep.writers.trace_parquet import write_trace_parquet
 
 from .ros_writer import KIND_LABEL, ORIGIN_NS, read_back_id, write_scene_updates, write_tracked
@@ -62,16 +65,15 @@ def inputs(request, av2_bag, tmp_path_factory):
     elif request.param == "SceneUpdate":
         bag_path = folder / "scene.mcap"
         write_scene_updates(trace, bag_path, "json")
-    bag = readers.read_trace(bag_path)
     ego = trace.object_index(trace.ego)
+    size = _ego_size(trace)
+    bag = read_bag(bag_path, BagOptions(ego_size=size))
     given = [str(o) if not autoware else read_back_id(str(o)) for o in trace.objects.id]
     ids = ["ego" if i == ego else o for i, o in enumerate(given)]
     classes = [LABELS[KIND_LABEL[k]] for k in trace.objects.kinds()] if autoware else list(trace.objects.category)
     categories = ["ego" if i == ego else c for i, c in enumerate(classes)]
     s = trace.states
-    unknown_for = s.object == ego
-    unknown = {c: np.where(unknown_for, np.nan, getattr(s, c)) for c in ("length", "width", "height")}
-    unknown |= {c: np.where(unknown_for | (not autoware), np.nan, getattr(s, c)) for c in ("vx", "vy")}
+    unknown = {c: np.where((s.object == ego) | (not autoware), np.nan, getattr(s, c)) for c in ("vx", "vy")}
     carried = replace(
         trace,
         name=bag.name,
@@ -82,7 +84,13 @@ def inputs(request, av2_bag, tmp_path_factory):
     )
     carried.validate()
     original = write_trace_parquet(carried, folder / "original.parquet")
-    return str(bag_path), str(original), trace.map_source.path
+    return str(bag_path), str(original), trace.map_source.path, ",".join(map(str, size))
+
+
+def _ego_size(trace) -> tuple[float, float, float]:
+    """The ego's (length, width, height) as the log records it (one size for every frame)."""
+    ego = trace.states.object == trace.object_index(trace.ego)
+    return tuple(float(np.unique(getattr(trace.states, c)[ego]).item()) for c in ("length", "width", "height"))
 
 
 def _rounded(value):
@@ -109,13 +117,13 @@ def _rows(argv, capsys) -> tuple[int, list[dict], str]:
 
 @pytest.mark.parametrize("query", QUERIES, ids=["scene", "scenario", "spre"])
 def test_each_query_kind_returns_on_the_bag_what_it_returns_on_the_trace(inputs, query, capsys, tmp_path):
-    bag, original, map_path = inputs
+    bag, original, map_path, ego_size = inputs
     command, text, options = query
     if command == "scene":
         (tmp_path / "near.scenic").write_text(text)
         text = str(tmp_path / "near.scenic")
     map_option = [] if command == "spre" else ["--map", map_path]  # the bag has no map; the trace names its own
-    from_bag = _rows([command, text, bag, *options, *map_option], capsys)
+    from_bag = _rows([command, text, bag, *options, *map_option, "--ego-size", ego_size], capsys)
     from_trace = _rows([command, text, original, *options], capsys)
     assert from_bag == from_trace
     code, rows, error = from_bag
@@ -123,3 +131,42 @@ def test_each_query_kind_returns_on_the_bag_what_it_returns_on_the_trace(inputs,
         assert "speed is unknown" in error and query[0] == "scenario" and "TrackedObjects" not in bag
     else:
         assert any(row["status"] == "match" for row in rows)  # the query finds something to compare
+
+
+EXTENT_QUERIES = [  # (command, query, options): each needs the ego's extent
+    ("scene", ONCOMING_NEAR, ["--unknown-layers", "permissive"]),
+    ("scenario", f"{REAL}/oncoming_vehicle.scenic", ["--unknown-layers", "permissive", "--window", "3s"]),
+    ("spre", "[@area([:ego:]) > 1]", ["--space", "topdown"]),
+    ("spre", "[NE([:ego:] & [:car:])]", ["--space", "topdown"]),
+]
+
+
+@pytest.mark.parametrize("query", EXTENT_QUERIES, ids=["scene", "scenario", "spre-area", "spre-intersection"])
+def test_without_the_ego_size_a_query_that_needs_the_ego_extent_is_an_error(av2_bag, query, capsys, tmp_path):
+    """/tf carries no ego size: a scene's containment of the ego's box, a SpRE's area of the ego's
+    region or its intersection are one-line errors naming --ego-size, never a default size; a
+    SpRE on the ego's centre (distance, side) needs none and runs."""
+    trace, bag = av2_bag
+    command, text, options = query
+    if command == "scene":
+        (tmp_path / "near.scenic").write_text(text)
+        text = str(tmp_path / "near.scenic")
+    options = options if command == "spre" else [*options, "--map", trace.map_source.path]
+    assert main([command, text, str(bag), *options]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no size for its ego 'ego'" in err and "--ego-size LENGTH,WIDTH,HEIGHT" in err
+    centre = "[@dist([:ego:], [:car:]) < 10 & <frontof>([:car:])]"
+    assert main(["spre", "--space", "topdown", centre, str(bag), "-q"]) in (0, 1)
+    assert capsys.readouterr().err.count("error") == 0
+
+
+def test_live_input_takes_the_ego_size_too(av2_bag, capsys):
+    """``--follow`` reads the bag with the same options: the ego's area is an error without
+    --ego-size, and with it the frames where the ego's box (4.87 m x 1.85 m in AV2) is over 9 m²."""
+    _, bag = av2_bag
+    query = ["spre", "--space", "topdown", "[@area([:ego:]) > 9]", "--follow", str(bag), "--idle-timeout", "1"]
+    assert main(query) == 2
+    assert "--ego-size LENGTH,WIDTH,HEIGHT" in capsys.readouterr().err
+    assert main([*query, "--ego-size", "4.87,1.85,1.48"]) == 0
+    assert len(capsys.readouterr().out.splitlines()) == 156  # every frame: one line each
+    assert main([*query, "--ego-size", "2,1.85,1.48"]) == 1  # 3.7 m²: none

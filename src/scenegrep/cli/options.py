@@ -14,7 +14,7 @@ Groups and who has them:
   scenario, spre, coverage) -> :class:`scenegrep.dataset.run.RunOptions`; ``-j/--jobs`` alone
   (ingest, serve);
 - ROS 2 bags and MCAP files, ``--topics``, ``--frame-topic``, ``--rate``, ``--map-frame``,
-  ``--ego-frame`` (info, scene, scenario, spre, label) ->
+  ``--ego-frame``, ``--ego-size`` (info, scene, scenario, spre, label) ->
   :class:`scenegrep.readers.ros.options.BagOptions`, put in force by :func:`bag_options_applied`;
 - live input, ``--follow FILE``, ``--idle-timeout S``, ``--latency`` (scenario, spre);
 - output files (``-o``, ``--html``, ``--png`` of show, report, coverage): :func:`check_output_file`
@@ -178,6 +178,12 @@ def add_bag_arguments(parser: argparse.ArgumentParser) -> None:
         "--map-frame", default="map", metavar="FRAME", help="the frame positions are given in (default: map)"
     )
     group.add_argument("--ego-frame", default="base_link", metavar="FRAME", help="the ego's frame (default: base_link)")
+    group.add_argument(
+        "--ego-size",
+        metavar="L,W,H",
+        help="the ego's length, width and height in metres (tf and odometry carry none: without it, a query "
+        "that needs the ego's extent is an error)",
+    )
 
 
 def bag_options_of(args: argparse.Namespace) -> Any:
@@ -189,13 +195,27 @@ def bag_options_of(args: argparse.Namespace) -> Any:
     from ..readers.ros.options import BagOptions
 
     topics = tuple(t.strip() for t in (args.topics or "").split(",") if t.strip())
-    options = BagOptions(topics, args.frame_topic, args.rate, args.map_frame, args.ego_frame)
+    ego_size = None if args.ego_size is None else _ego_size(args.ego_size)
+    options = BagOptions(topics, args.frame_topic, args.rate, args.map_frame, args.ego_frame, ego_size)
     if getattr(args, "dataset", None) is not None and options != BagOptions():
         raise UserError(
-            "--topics, --frame-topic, --rate, --map-frame and --ego-frame apply when bags are read; a dataset's "
-            "traces were read at ingest (with the defaults): query the bags as files instead"
+            "--topics, --frame-topic, --rate, --map-frame, --ego-frame and --ego-size apply when bags are read; a "
+            "dataset's traces were read at ingest (with the defaults): query the bags as files instead"
         )
     return options
+
+
+def _ego_size(text: str) -> tuple[float, ...]:
+    """``--ego-size L,W,H`` as three floats (checked by :class:`BagOptions`); UserError if not numbers."""
+    from ..readers.ros.options import check_ego_size
+
+    parts = text.split(",")
+    try:
+        size = tuple(float(part) for part in parts[:4])
+    except ValueError:
+        raise UserError(f"--ego-size {text[:40]!r}: give LENGTH,WIDTH,HEIGHT in metres, e.g. 4.9,1.9,1.5") from None
+    check_ego_size(size)
+    return size
 
 
 @contextlib.contextmanager

@@ -23,6 +23,12 @@ from .objects import ObjectTable
 from .states import StateTable
 
 
+EGO_SIZE_UNKNOWN = "ego_size_unknown"
+"""Trace attribute of a reader whose data gives the ego's pose but not its size (a ROS bag's
+``/tf`` or odometry): its value says why and how to give the size. The ego's length, width and
+height are then NaN, and a query that needs the ego's extent is an error quoting it (never a
+default size)."""
+
 MAX_FRAMES = 10_000_000
 """The most frames a trace may have (about 11.5 days at 10 Hz): a frame count or range a file
 states is checked against it before any array is sized by it."""

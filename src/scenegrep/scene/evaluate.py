@@ -23,6 +23,7 @@ from ..errors import UserError, at
 from ..model import LabelTrace
 from ..model.geometry import heading_of_vector, normalize_angle
 from ..model.kinematics import ESTIMATED_VELOCITY, finite_difference_acceleration
+from ..model.trace import EGO_SIZE_UNKNOWN
 from .follow import walk_end
 from .geometry import MapGeometry
 from .program import TRACE, ProgramObject
@@ -97,6 +98,27 @@ class Labels:
     def ay(self) -> np.ndarray | None:
         """Acceleration along y (m/s²) per state row; None when the trace has no velocities."""
         return None if self._acceleration is None else self._acceleration[1]
+
+    def size(self, obj: str, feature: str, states: np.ndarray, default: float) -> np.ndarray:
+        """Length or width (``feature``, m) of program object ``obj`` at label state rows ``states``,
+        the class's ``default`` where the trace gives none; a :class:`UserError` instead where the
+        row is the trace's ego and the trace says its ego's size is unknown
+        (:data:`~scenegrep.model.trace.EGO_SIZE_UNKNOWN`: a bag's ego)."""
+        column = getattr(self, feature)[states]
+        missing = np.isnan(column)
+        reason = self.attributes.get(EGO_SIZE_UNKNOWN)
+        trace = self.trace
+        if reason is not None and trace is not None and trace.ego is not None and missing.any():
+            ego = np.flatnonzero(missing & (trace.states.object[states] == trace.object_index(trace.ego)))
+            if len(ego):
+                frame = int(trace.frame_index[trace.states.frame[states[ego[0]]]])
+                where = None if trace.source is None else at(trace.source.path)
+                message = (
+                    f"{obj}.{feature} is unknown: trace {trace.name!r} has no size for its ego {trace.ego!r} "
+                    f"(at frame {frame}); {reason}"
+                )
+                raise UserError(message, where)
+        return np.where(missing, default, column)
 
     def _unknown(self, obj: str, feature: str, state: int) -> UserError:
         if self.trace is None:
@@ -278,10 +300,9 @@ class Evaluator:
         states = self.rows.state[obj][self.origin]
         if feature in DYNAMIC_COLUMNS:
             return self.labels.dynamic(obj, feature, states)
-        column = getattr(self.labels, feature)[states]
         if feature in ("width", "length"):
-            column = np.where(np.isnan(column), self.objects[obj].default_size[feature], column)
-        return column
+            return self.labels.size(obj, feature, states, self.objects[obj].default_size[feature])
+        return getattr(self.labels, feature)[states]
 
     def _geometry(self, term: Term) -> np.ndarray:
         op = term.op

@@ -162,7 +162,8 @@ class Evaluator:
                 regions = self.term(term, ctx)
                 return _any_per_row(regions.ctx[regions.nonempty()], len(ctx))
             case s.Subset(left, right):
-                return _any_per_row(r.subset_contexts(self.term(left, ctx), self.term(right, ctx)), len(ctx))
+                inner, outer = self._extent(left, ctx, "<subset>"), self._extent(right, ctx, "<subset>")
+                return _any_per_row(r.subset_contexts(inner, outer), len(ctx))
             case s.Compare():
                 return self.compare(f, ctx)
             case s.Relation():
@@ -267,14 +268,20 @@ class Evaluator:
                 return r.concat([self.term(left, ctx), self.term(right, ctx)])
             case s.Intersection(left, right):
                 combine = r.strem_intersection if self.strem else r.intersection
-                return combine(self.term(left, ctx), self.term(right, ctx))
+                return combine(self._extent(left, ctx, "an intersection"), self._extent(right, ctx, "an intersection"))
             case s.Complement(term):
-                return r.complement(self.term(term, ctx), self.space.universe[ctx.sample])
+                return r.complement(self._extent(term, ctx, "a complement"), self.space.universe[ctx.sample])
             case s.Interior(term):
-                return r.interior(self.term(term, ctx))
+                return r.interior(self._extent(term, ctx, "an interior"))
             case s.Closure(term):
-                return r.closure(self.term(term, ctx))
+                return r.closure(self._extent(term, ctx, "a closure"))
         raise TypeError(f"not a term: {t!r}")
+
+    def _extent(self, t: s.Term, ctx: Context, what: str) -> r.Regions:
+        """The regions of ``t``, whose extents ``what`` reads (:meth:`Space.check_extent`)."""
+        regions = self.term(t, ctx)
+        self.space.check_extent(regions, what)
+        return regions
 
     # ------------------------------------------------------------------ metric expressions
     def metric(self, m: s.Metric, ctx: Context) -> Values:
@@ -298,6 +305,9 @@ class Evaluator:
     def function(self, f: s.Function, ctx: Context) -> Values:
         args = [self.term(arg, ctx) for arg in f.args]
         name = {"w": "width", "h": "height"}.get(f.name, f.name)
+        if name in EXTENT_FUNCTIONS:
+            for arg in args:
+                self.space.check_extent(arg, f"@{f.name}(...)")
         if len(args) == 2:
             a, b = args
             i, j = r.pairs(a.ctx, b.ctx)
@@ -343,4 +353,6 @@ def _iou(a: r.Regions, b: r.Regions) -> np.ndarray:
 
 
 _PAIR_FUNCTIONS = {"dist": _distance, "gap": _gap, "iou": _iou}
+EXTENT_FUNCTIONS = frozenset({"area", "width", "height", "gap", "iou"})
+"""The functions that read their regions' extents (``dist``, ``x``, ``y`` read centres)."""
 _ARITHMETIC = {"+": np.add, "-": np.subtract, "*": np.multiply, "/": np.divide, "^": np.power}

@@ -8,7 +8,11 @@ Two spaces (seed 004 §2.1, "image space" and "top-down space"):
 - ``topdown``: the trace's object states. Each frame is one sample; each observed
   object is an oriented box in metres (centre x, y, heading, length, width; a point when
   the size is unknown); the ego is the trace's ego object; the bounds are the frame's
-  objects' extent grown by a kilometre.
+  objects' extent grown by a kilometre. A trace whose ego's size is unknown
+  (:data:`~scenegrep.model.trace.EGO_SIZE_UNKNOWN`, a bag's ego) keeps the ego as a point for
+  its centre and heading, but a formula that reads the ego region's extent (areas, widths,
+  gaps, IoU, intersections, complements, interiors, closures) is an error
+  (:attr:`Space.ego_extent_unknown`), not an answer about a point.
 
 A formula is evaluated on every sample on its own; a frame satisfies it when one of its
 samples does (a frame without samples satisfies nothing).
@@ -26,6 +30,7 @@ from ..errors import UserError
 from ..model import LabelTrace, SampleTable
 from ..model.geometry import box_corners
 from ..model.taxonomy import kind_of
+from ..model.trace import EGO_SIZE_UNKNOWN
 from . import syntax as s
 from .regions import Regions
 
@@ -61,6 +66,8 @@ class Space:
     object_attributes: np.ndarray
     ego: int
     match_kinds: bool
+    ego_extent_unknown: str | None = None
+    """Why the ego's extent is unknown (None: known, or no ego): reading it is an error."""
 
     @property
     def n_samples(self) -> int:
@@ -153,6 +160,14 @@ class Space:
             attrs = self.object_attributes
             values = np.array([attrs[o].get(flt.key) if o >= 0 else None for o in self.object], dtype=object)
         return _compare(values, flt.op, flt.value)
+
+    def check_extent(self, regions: Regions, what: str) -> None:
+        """UserError when ``what`` reads the extent of the ego's region and it is unknown."""
+        if self.ego_extent_unknown is None or not len(regions):
+            return
+        src = regions.src[regions.src >= 0]
+        if np.any(self.object[src] == self.ego):
+            raise UserError(f"{what} reads the extent of the ego's region, and {self.ego_extent_unknown}")
 
     def samples_having(self, mask: np.ndarray) -> np.ndarray:
         """Per sample, whether it has a region of the row mask."""
@@ -289,4 +304,18 @@ def topdown_space(trace: LabelTrace, match_kinds: bool) -> Space:
         trace.objects.attributes,
         -1 if trace.ego is None else trace.object_index(trace.ego),
         match_kinds,
+        _ego_extent_unknown(trace),
     )
+
+
+def _ego_extent_unknown(trace: LabelTrace) -> str | None:
+    """Why the ego's extent is unknown: the trace says its ego's size is unknown and the ego has
+    no length or width at some frame (None otherwise)."""
+    reason = trace.attributes.get(EGO_SIZE_UNKNOWN)
+    if reason is None or trace.ego is None:
+        return None
+    st = trace.states
+    ego = st.object == trace.object_index(trace.ego)
+    if not np.any(ego & (np.isnan(st.length) | np.isnan(st.width))):
+        return None
+    return f"trace {trace.name!r} has no size for its ego {trace.ego!r}; {reason}"

@@ -31,7 +31,8 @@ trace of one chunk.
 ``ego_frame``'s pose in the map frame at the frame's stamp, when ``ego_frame`` reaches the map
 frame. Headings come from the yaw of the box in the map frame; velocities are the box's twist
 turned into the map frame; the ego's velocity is its odometry twist where an odometry topic
-gives its link (NaN from ``/tf``), its size unknown. A missing transform at the
+gives its link (NaN from ``/tf``), its size ``ego_size`` (unknown without it: NaN, and the
+trace attribute :data:`~scenegrep.model.trace.EGO_SIZE_UNKNOWN` says so). A missing transform at the
 end of input is a :class:`UserError` naming the topic and the message's log time.
 """
 
@@ -46,6 +47,7 @@ import numpy as np
 from ...errors import UserError
 from ...model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
 from ...model.geometry import heading_from_yaw
+from ...model.trace import EGO_SIZE_UNKNOWN
 from .decoders import BOX_TYPES, LINK_TYPES, decode_batch, supported, type_key
 from .messages import Boxes, DecodeError, ImageBoxes, RawMessage
 from .msgdef import DefinitionError
@@ -335,9 +337,15 @@ class FrameBuilder:
             raise UserError(
                 f"ego frame {self.options.ego_frame!r} at stamp {int(stamps[exc.row])} ns: {exc.reason}"
             ) from None
-        size = np.full((len(stamps), 3), np.nan)
+        size = np.tile(np.asarray(self.options.ego_size or (np.nan,) * 3, dtype=float), (len(stamps), 1))
         velocity = self.tf.velocity(self.options.ego_frame, self.options.map_frame, stamps, quat)
         return np.column_stack([xyz, heading_from_yaw(yaw_of(quat)), size, velocity[:, :2]])
+
+    def _ego_size_note(self) -> dict[str, str]:
+        """The :data:`EGO_SIZE_UNKNOWN` attribute when the options give no ego size."""
+        if self.options.ego_size is not None:
+            return {}
+        return {EGO_SIZE_UNKNOWN: "/tf and odometry carry no size: give it with --ego-size LENGTH,WIDTH,HEIGHT"}
 
     def _trace(self, stamps, ids, categories, frame, columns, has_ego: bool, images: ImageLayer | None) -> LabelTrace:
         if self.origin is None:
@@ -380,7 +388,7 @@ class FrameBuilder:
             states,
             ego=EGO_ID if has_ego else None,
             images=images,
-            attributes={"dataset": "ros2-bag", "time_origin_ns": self.origin},
+            attributes={"dataset": "ros2-bag", "time_origin_ns": self.origin, **self._ego_size_note()},
             source=self.source,
         )
         self.emitted += len(stamps)

@@ -345,7 +345,10 @@ class FrameBuilder:
         """The :data:`EGO_SIZE_UNKNOWN` attribute when the options give no ego size."""
         if self.options.ego_size is not None:
             return {}
-        return {EGO_SIZE_UNKNOWN: "/tf and odometry carry no size: give it with --ego-size LENGTH,WIDTH,HEIGHT"}
+        return {
+            EGO_SIZE_UNKNOWN: "/tf and odometry carry no size: give it with --ego-size LENGTH,WIDTH,HEIGHT when the "
+            "bag is read (a dataset ingested it without: query the bag as a file)"
+        }
 
     def _trace(self, stamps, ids, categories, frame, columns, has_ego: bool, images: ImageLayer | None) -> LabelTrace:
         if self.origin is None:

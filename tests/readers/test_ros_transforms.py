@@ -7,11 +7,11 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.readers.ros.messages import Transforms
-from scenegrep.readers.ros.transforms import MissingTransform, TfBuffer, yaw_of
+from scenegrep.readers.ros.transforms import MissingTransform, TfBuffer, _Link, yaw_of
 
 coordinate = st.floats(-1e4, 1e4)
 angle = st.floats(-math.pi, math.pi)
@@ -66,3 +66,22 @@ def test_a_cycle_is_no_chain():
     buffer.add(_links("a", "b", [0], [(0, 0)], [0]))
     buffer.add(_links("b", "a", [0], [(0, 0)], [0]))
     assert buffer.chain("a", "map") is None
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.lists(st.integers(0, 20), max_size=6), min_size=1, max_size=5), st.lists(st.booleans(), max_size=5))
+def test_a_link_keeps_the_last_sample_received_per_stamp_however_it_is_fed(batches, reads):
+    link, received = _Link("map", False), []
+    for k, stamps in enumerate(batches):
+        xyz = np.array([[len(received) + j, 0.0, 0.0] for j in range(len(stamps))]).reshape(-1, 3)
+        link.add(np.array(stamps, dtype=np.int64), xyz, np.tile([0.0, 0.0, 0.0, 1.0], (len(stamps), 1)), None)
+        received += stamps
+        if k < len(reads) and reads[k] and received:
+            link.arrays()  # merged between batches, or not
+    if not received:
+        return
+    stamps, xyz, _, velocity = link.arrays()
+    last = {stamp: i for i, stamp in enumerate(received)}
+    assert stamps.tolist() == sorted(last)
+    assert xyz[:, 0].tolist() == [last[s] for s in sorted(last)]
+    assert np.isnan(velocity).all()

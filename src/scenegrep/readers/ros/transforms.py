@@ -81,32 +81,27 @@ def yaw_of(q: np.ndarray) -> np.ndarray:
 class _Link:
     parent: str
     static: bool
-    stamps: list[int] = field(default_factory=list)
-    xyz: list[np.ndarray] = field(default_factory=list)
-    quat: list[np.ndarray] = field(default_factory=list)
-    velocity: list[np.ndarray] = field(default_factory=list)
+    pending: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
     _arrays: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def add(self, stamps: np.ndarray, xyz: np.ndarray, quat: np.ndarray, velocity: np.ndarray | None) -> None:
-        self.stamps.extend(stamps.tolist())
-        self.xyz.append(xyz)
-        self.quat.append(normalised(quat))
-        self.velocity.append(np.full(xyz.shape, np.nan) if velocity is None else velocity)
-        self._arrays = None
+        velocity = np.full(xyz.shape, np.nan) if velocity is None else velocity
+        self.pending.append((np.asarray(stamps, dtype=np.int64), xyz, normalised(quat), velocity))
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Stamps (sorted, one sample per stamp: the last received), positions, rotations,
-        velocities (in the child frame; NaN unknown)."""
-        if self._arrays is None:
-            stamps = np.asarray(self.stamps, dtype=np.int64)
-            columns = [np.concatenate(c) for c in (self.xyz, self.quat, self.velocity)]
-            order = np.argsort(stamps, kind="stable")
-            stamps = stamps[order]
+        velocities (in the child frame; NaN unknown). Samples added since the last call are
+        merged into the arrays then (no sort when they come in stamp order, as they do)."""
+        if self.pending:
+            parts = ([self._arrays] if self._arrays is not None else []) + self.pending
+            stamps, xyz, quat, velocity = (np.concatenate([p[k] for p in parts]) for k in range(4))
+            if not (stamps[1:] >= stamps[:-1]).all():
+                order = np.argsort(stamps, kind="stable")
+                stamps, xyz, quat, velocity = stamps[order], xyz[order], quat[order], velocity[order]
             last = np.r_[stamps[1:] != stamps[:-1], True]
-            xyz, quat, velocity = (c[order][last] for c in columns)
-            self._arrays = (stamps[last], xyz, quat, velocity)
-            self.stamps, self.xyz, self.quat, self.velocity = stamps[last].tolist(), [xyz], [quat], [velocity]
-        return self._arrays
+            self._arrays = (stamps[last], xyz[last], quat[last], velocity[last])
+            self.pending = []
+        return self._arrays  # type: ignore[return-value]
 
     def at(self, stamps: np.ndarray, child: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, rotation and velocity of the child at each stamp (see the module docstring)."""

@@ -22,11 +22,27 @@ the lane from its centreline) plus the widest gap of an intersection area outsid
 candidate is also dropped when p_k's segment stays farther than that from every segment with its
 heading (no point of that segment can take it).
 
-Exact up to that reading at midpoints: of 360 random Town01 walks of 20-30 m backwards from lane
-points, the start and distance of one were missing from the preimage of its end (the heading
-changes inside a cut there). Cuts are only made where the heading may change to or from the one
-tried: a centreline vertex line changes it only between its two segments' headings, a tie only
-between its pair's.
+Why the preimage holds every walk ending at E (the invariant a refutation rests on): take a walk
+from X for D with headings h_0 .. h_{n-1} and points p_0 = X .. p_n = E. Going back from p_{k+1},
+the segment that gives p_k its heading lies within its reach of p_k, and p_k within |D| / n of
+p_{k+1}, so h_k is among the candidates, and p_k = E + D b_k lies on the branch's swept segment
+for that D. The field at p_k is h_k, and the D sub-interval holding D is one on which the field
+does not change: it changes only (i) across an area boundary (a lane, intersection or shoulder,
+and the 5 cm bands around them), which decides the rule that applies, or (ii) within one lane,
+where its nearest centreline segment changes: at a vertex line between adjacent segments that
+turn by less than 90°, or where two segments between which the centreline turns by more than 90°
+(adjacent or not: a lane section folding back joins two almost opposite adjacent segments, whose
+equally-near set no vertex line marks) are equally near; all are cuts (:func:`.follow_pieces.crossings`).
+So the midpoint reads h_k. Left out: D exactly at a cut (a finite set, read as a neighbour),
+and the nearest-lane rule (in an intersection area between its lanes, within 5 cm of a lane),
+assumed not to change inside a sub-interval. tests/scene/test_follow_start.py walks random
+Town01 starts forward and finds each in the preimage of its end; before adjacent folds were
+pairs, one of 360 (and of 300) was missing, since then none of 3,600 (D in [-30, 30]).
+Only the changes to or from the heading tried are cut: a vertex line changes it only between
+its two segments' headings, a tie only between its pair's.
+
+The preimage is that of one point E (the caller's end box's centre): a walk that ends in the
+box but not at E is not in it.
 
 With ``check_first=False`` the first heading h_0 is not checked against the field along X's
 segment: the caller checks it at the start it picks (a start on a curb lies on the linework, where

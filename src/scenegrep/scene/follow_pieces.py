@@ -17,8 +17,9 @@ at each interior vertex of a centreline (a lane's or a shoulder's), its two segm
 their bisector (where the projection onto the centreline passes the vertex or jumps across the
 inner side), reaching 1 m beyond the lane or shoulder;
 or, where a centreline turns by more than 90° within twice its reach (the lane's half width
-plus 1 m; folds where lane sections join, sharp bends), a point equally near two non-adjacent
-segments and nearer than the rest (roots of a difference of squared distances, piecewise
+plus 1 m; folds where lane sections join, sharp bends), a point equally near two segments (also
+adjacent ones: a fold joins two almost opposite ones, whose vertex lines miss where they are
+equally near) and nearer than the rest (roots of a difference of squared distances, piecewise
 quadratic in D). For a
 fixed step count and a fixed sequence of headings every point of the walk is affine in D, so
 the points of step k sweep a segment as D runs over an interval; cutting that segment where it
@@ -30,7 +31,7 @@ box the end must reach (the label and its tolerance), a branch is dropped as soo
 remaining steps (each ``|D| / n`` long) cannot bring it there.
 
 Exact up to the boundaries between pieces (D values where a walk point lies on the linework,
-a finite set), with two assumptions: non-adjacent centreline segments compete only across a
+a finite set), with two assumptions: centreline segments other than neighbours compete only across a
 turn of more than 90° (true when the centreline's radius of curvature exceeds the lane's half
 width; tests walk Town01 and Town06 at random against the step-by-step walk); and where a point
 lies in no lane but inside an intersection area or within 5 cm of a lane or intersection, or
@@ -64,7 +65,7 @@ TIE_M = 1e-7
 """Two competing segments' equal distance counts as the nearest distance within this (metres)."""
 
 TURN_RAD = np.pi / 2
-"""Non-adjacent centreline segments compete for points of their lane only where the centreline
+"""Centreline segments (neighbours too) compete for points of their lane only where the centreline
 turns by more than this between them (folds where pieces of a lane join, sharp bends); elsewhere
 the nearest segment changes at a vertex line."""
 
@@ -81,7 +82,7 @@ class Linework:
     """Where ``roadDirection`` may change (see the module docstring): segments with an R-tree (and,
     for the lines at a centreline's vertex, the headings of the segments either side, between
     which alone the heading may change there; NaN for area boundaries), and
-    pairs of non-adjacent centreline segments of one lane that may compete for a point, with an
+    pairs of centreline segments of one lane that may compete for a point, with an
     R-tree of the boxes where they may (within the lane's reach of both); the centreline segments
     as lines; an R-tree of where a lane's direction may count at all (each lane grown by Scenic's
     tolerance, and the intersection areas, where the nearest lane may count)."""
@@ -166,14 +167,15 @@ def _build_linework(geometry: MapGeometry) -> Linework:
 
 
 def _competing_pairs(polylines: Polylines, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Non-adjacent segment pairs (i < j - 1, flat indices) of one centreline within twice the
+    """Segment pairs (i < j, flat indices) of one centreline turning by more than TURN_RAD from one
+    to the other (a fold between neighbours included) within twice the
     lane's reach of each other, their lane, and the box of points within reach of both."""
     segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
     owner = np.repeat(np.arange(len(polylines)), polylines.count)
     near = reach[owner] + REACH_MARGIN_M
     i, j = shapely.STRtree(segments).query(segments, predicate="dwithin", distance=2 * near.max(initial=0.0))
     turned = np.concatenate([[0.0], np.cumsum(np.abs(_wrap(np.diff(polylines.heading))))])
-    keep = (j > i + 1) & (owner[i] == owner[j])
+    keep = (j > i) & (owner[i] == owner[j])
     i, j = i[keep], j[keep]
     keep = turned[j] - turned[i] > TURN_RAD
     i, j = i[keep], j[keep]

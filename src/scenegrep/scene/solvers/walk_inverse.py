@@ -16,24 +16,16 @@ start found there, walked again with Scenic's rule (:func:`~..follow.walk_end`) 
 against the row's whole system (:func:`.pointwise.satisfies`, requirements included), is the
 witness. All rows of a call are inverted together (:func:`start_preimages`).
 
-Refutation (the one "unsat" this module gives): no value the field may take in the end's box (a
-superset: :meth:`~..geometry.MapGeometry.field_headings_in_box`) meets the heading bounds. Every
-other row without a witness is undecided, and the caller decides it by the forward enumeration of
-:mod:`.walk_start` (a curb start) or by the general solvers (a region or box start), which refute
-soundly: the preimage is not relied on to refute, because it may miss a walk (random Town01 walks
-whose start is not in the preimage of their end: :mod:`..follow_inverse`), and a wrong refutation
-is a silently wrong "no match".
+Refutation: no value the field may take in the end's box (a superset:
+:meth:`~..geometry.MapGeometry.field_headings_in_box`) meets the heading bounds, or no preimage
+segment meets the domain (no start in the domain walks to E: the preimage holds every walk, see
+:mod:`..follow_inverse`). A row whose candidate starts all fail the check (a walk through a cut
+point, or a requirement the start does not meet) is undecided, and the caller decides it by the
+forward enumeration of :mod:`.walk_start` (a curb start) or by the general solvers.
 
-Speed (Town01, ``benchmarks/bench_follow.py``: 30 Scenic scenes per start, CPU ms per one-frame
-match, median / p95; refuted = the frames moved 3 m or turned 0.3 rad; same run's known start:
-4.8 / 9.0 matched, 3.6 / 7.9 refuted): curb starts 15.8 / 26 matched, 9.3 / 29 refuted (before,
-with the forward enumeration of :mod:`.walk_start` alone: 105 median / 650 max matched, about
-1.5 s refuted); region starts 28 / 107 matched, 14 / 75 refuted (before: the general solvers,
-undecided, without a witness: about 7 s matched, 6 s moved 3 m; median of 6 frames, one run).
-Those refuted numbers are from when the preimage refuted alone; with the fallback (one run, 30
-frames, repeat 1, known 3.6 / 3.1 ms): curb 12.7 / 21 matched, 133 / 3112 refuted; region
-26 / 110 matched, 35 / 11464 refuted. An earlier run (before a cheaper candidate search) gave
-medians of 18 / 11 (curb) and 26 / 10 (region): the machine was shared, so these vary by about a fifth.
+Speed (Town01, ``benchmarks/bench_follow.py``, CPU ms per one-frame match, median / p95; refuted =
+the frames moved 3 m or turned 0.3 rad): see the README (section on ``following``), which keeps
+the numbers before and after each change.
 """
 
 from __future__ import annotations
@@ -172,14 +164,15 @@ def solve_start_walk(
         d, sx, sy = _on_curbs(geometry, ex, ey, pre, lines, margin)
     else:
         d, sx, sy = _inside(ex, ey, pre, lines, domain)
-    if len(d):
-        end_x, end_y = walk_end(geometry, ROAD_DIRECTION, sx, sy, d, no_parameters)
-        ends = (end_x >= x0) & (end_x <= x1) & (end_y >= y0) & (end_y <= y1)
-        for k in np.flatnonzero(ends).tolist():
-            assignment = {walk.distance: float(d[k]), walk.x: float(sx[k]), walk.y: float(sy[k])}
-            walked = {**assignment, walk.ends[0]: float(end_x[k]), walk.ends[1]: float(end_y[k])}
-            if satisfies(problem, geometry, walked):
-                return Outcome("sat", assignment, "follow-start")
+    if not len(d):
+        return Outcome("unsat", None, "follow-start")
+    end_x, end_y = walk_end(geometry, ROAD_DIRECTION, sx, sy, d, no_parameters)
+    ends = (end_x >= x0) & (end_x <= x1) & (end_y >= y0) & (end_y <= y1)
+    for k in np.flatnonzero(ends).tolist():
+        assignment = {walk.distance: float(d[k]), walk.x: float(sx[k]), walk.y: float(sy[k])}
+        walked = {**assignment, walk.ends[0]: float(end_x[k]), walk.ends[1]: float(end_y[k])}
+        if satisfies(problem, geometry, walked):
+            return Outcome("sat", assignment, "follow-start")
     return Outcome("undecided", None, "follow-start")
 
 

@@ -8,6 +8,8 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
+from functools import cache
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -16,6 +18,7 @@ import pytest
 from scenegrep import readers
 from scenegrep.dataset import QuerySpec, RunOptions, open_dataset
 from scenegrep.dataset.catalog import Catalog
+from scenegrep.dataset.results import Results
 from scenegrep.dataset.run import run_query
 from scenegrep.errors import UserError
 from scenegrep.label import label_trace
@@ -45,9 +48,11 @@ def specs() -> dict[str, QuerySpec]:
     }
 
 
+@cache
 def one_by_one(kind: str, root: Path) -> dict[str, list[tuple]]:
     """Trace name -> its matches (first frame, last frame, correspondence), each source read and
-    queried on its own with the query packages (no dataset engine)."""
+    queried on its own with the query packages (no dataset engine); computed once per test process
+    for each kind and dataset (the local pool and Ray are both checked against it)."""
     with Catalog(root, read_only=True) as catalog:
         sources = [s for (s,) in catalog.rows("SELECT path FROM sources ORDER BY path")]
     scenario, scene = load_scenario(SCENARIO), load_scene(SCENE)
@@ -75,6 +80,13 @@ def one_by_one(kind: str, root: Path) -> dict[str, list[tuple]]:
     return found
 
 
+@pytest.fixture(scope="module")
+def pooled(real_dataset: Path) -> Callable[[str], Results]:
+    """The results of each kind's query over the real dataset on the local pool (two jobs), run
+    once per module: several tests compare other runs with the same reference."""
+    return cache(lambda kind: run_query(real_dataset, specs()[kind], RunOptions(jobs=2)))
+
+
 def by_trace(results) -> dict[str, list[tuple]]:
     found: dict[str, list[tuple]] = {}
     for row in results.to_arrow().to_pylist():
@@ -87,8 +99,8 @@ def by_trace(results) -> dict[str, list[tuple]]:
 
 
 @pytest.mark.parametrize("kind", ["scenario", "scene", "spre"])
-def test_local_pool_equals_trace_by_trace(real_dataset: Path, kind: str):
-    results = run_query(real_dataset, specs()[kind], RunOptions(jobs=2))
+def test_local_pool_equals_trace_by_trace(real_dataset: Path, pooled, kind: str):
+    results = pooled(kind)
     assert results.status == "finished"
     expected = one_by_one(kind, real_dataset)
     assert by_trace(results) == expected
@@ -163,9 +175,9 @@ def final_results(root: Path):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("stop", [signal.SIGKILL, signal.SIGINT])
-def test_an_interrupted_run_resumes_to_the_same_results(real_dataset: Path, tmp_path: Path, stop: int):
+def test_an_interrupted_run_resumes_to_the_same_results(real_dataset: Path, pooled, tmp_path: Path, stop: int):
     root = copy_of(real_dataset, tmp_path)
-    reference = run_query(real_dataset, specs()["scenario"], RunOptions(jobs=2)).to_arrow()
+    reference = pooled("scenario").to_arrow()
     process = subprocess.Popen(scenario_command(root, "-q"), stderr=subprocess.PIPE, text=True)
     wait_for_part(root, process)
     process.send_signal(stop)
@@ -201,17 +213,26 @@ def test_a_trace_that_fails_is_recorded_and_the_run_goes_on(real_dataset: Path, 
     assert sum(r["status"] == "match" for r in table) == 11  # the 12 matches less the broken trace's
 
 
-def test_cli_outputs_and_the_catalog_agree(real_dataset: Path, tmp_path: Path):
+def in_process(argv: list[str], capsys) -> list[str]:
+    """The standard output of ``cli(*args)`` run by the CLI's ``main`` in this process, which must
+    return 0 (the tests of interruptions, failures and the terminal run the real process)."""
+    from scenegrep.cli.main import main
+
+    capsys.readouterr()
+    assert main(argv[3:]) == 0
+    return capsys.readouterr().out.splitlines()
+
+
+def test_cli_outputs_and_the_catalog_agree(real_dataset: Path, tmp_path: Path, capsys):
     root = copy_of(real_dataset, tmp_path)
-    lines = subprocess.run(scenario_command(root), capture_output=True, text=True, check=True).stdout.splitlines()
+    lines = in_process(scenario_command(root), capsys)
     assert len(lines) == 12 and lines[0].startswith("fig1_lane_change-000:0-74  ego=ego")
-    rows = subprocess.run(scenario_command(root, "--json"), capture_output=True, text=True).stdout.splitlines()
-    records = [json.loads(r) for r in rows]
+    records = [json.loads(r) for r in in_process(scenario_command(root, "--json"), capsys)]
     assert len(records) == 62 and sum(r["status"] == "match" for r in records) == 12
     output = tmp_path / "out.parquet"
-    csv = subprocess.run(scenario_command(root, "--csv", "--output", str(output)), capture_output=True, text=True)
-    assert csv.stdout.splitlines()[0].startswith("trace_id,name,source,status")
-    assert len(csv.stdout.splitlines()) == 63
+    csv = in_process(scenario_command(root, "--csv", "--output", str(output)), capsys)
+    assert csv[0].startswith("trace_id,name,source,status")
+    assert len(csv) == 63
     assert pq.read_table(output).equals(final_results(root))
     dataset = open_dataset(root)
     run_id = dataset.sql("SELECT run_id FROM runs").to_pylist()[0]["run_id"]
@@ -274,8 +295,8 @@ def test_user_errors_are_one_line(tmp_path: Path):
         QuerySpec.from_file("scene", SCENE, tolerance_position=-0.1)
 
 
-def test_window_in_seconds_prunes_and_matches_as_frames(real_dataset: Path):
-    frames = run_query(real_dataset, specs()["scenario"], RunOptions(jobs=2)).to_arrow()
+def test_window_in_seconds_prunes_and_matches_as_frames(real_dataset: Path, pooled):
+    frames = pooled("scenario").to_arrow()
     seconds = run_query(
         real_dataset,
         QuerySpec.from_file("scenario", SCENARIO, window="7.5s", unknown_layers=UNKNOWN),

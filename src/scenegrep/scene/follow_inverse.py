@@ -187,10 +187,10 @@ def preimages(
         moved = _candidates(inv, ex, ey, b)
         if domain is not None:
             moved = moved.take(np.flatnonzero(_may_start(ex, ey, moved.branches, domain)))
-            if check_first:
-                moved = _clipped(ex, ey, moved, domain)
         if check_first:
             moved = _consistent(geometry, field, lw, ex, ey, moved)
+            if domain is not None:
+                moved = _clipped(ex, ey, moved, domain)
         else:
             keep = moved.take(np.flatnonzero(~last[moved.parent]))
             first = moved.take(np.flatnonzero(last[moved.parent]))
@@ -230,7 +230,9 @@ def _may_start(ex, ey, b: _Back, domain: np.ndarray) -> np.ndarray:
 
 def _clipped(ex, ey, moved: _Moved, domain: np.ndarray) -> _Moved:
     """The branches with no step left, their D intervals narrowed to the hull of the D whose start
-    lies in the domain (those with none dropped)."""
+    lies in the domain (those with none dropped). Called after :func:`_consistent`, on the few
+    sub-intervals whose first heading holds (intersecting a swept segment with a region is the
+    dearest operation here)."""
     b = moved.branches
     last = np.flatnonzero(b.left == 0)
     if not len(last):

@@ -245,21 +245,29 @@ def _unknown_layers_line(err: list[str]) -> list[str]:
     return [line for line in err if line.startswith("scenegrep: --unknown-layers")]
 
 
+@pytest.fixture(scope="module")
+def nuscenes_fleet(real_data, tmp_path_factory) -> Path:
+    """The nuScenes recordings ingested unlabelled with two workers, once for the module (the
+    queries below write only their own runs into it)."""
+    from scenegrep.dataset.ingest import ingest
+
+    fleet = tmp_path_factory.mktemp("nuscenes") / "fleet"
+    assert not ingest([str(real_data / "nuscenes_mini_scenarionet")], fleet, jobs=2, label=False).failed
+    return fleet
+
+
 @pytest.mark.real_data
 @pytest.mark.parametrize("mode", ["permissive", "strict"])
-def test_dataset_workers_report_the_unknown_layer_decisions_of_files(mode, real_data, tmp_path, capsys):
+def test_dataset_workers_report_the_unknown_layer_decisions_of_files(mode, real_data, nuscenes_fleet, tmp_path, capsys):
     """The nuScenes recordings publish no crosswalks: a query that needs them reports on stderr how
     many decisions the choice affected; a dataset run whose workers (two processes) made them
     reports the same count as the query over the same files."""
-    from scenegrep.dataset.ingest import ingest
-
     recordings = real_data / "nuscenes_mini_scenarionet"
     program = tmp_path / "crossing.scenic"
     program.write_text(CROSSING_QUERY)
-    assert not ingest([str(recordings)], tmp_path / "fleet", jobs=2, label=False).failed
     options = ["--unknown-layers", mode, "--no-values", "-q"]
     _, _, over_files = run(["scene", program, recordings, *options], capsys)
-    _, _, over_dataset = run(["scene", program, *options, "--dataset", tmp_path / "fleet", "-j", "2"], capsys)
+    _, _, over_dataset = run(["scene", program, *options, "--dataset", nuscenes_fleet, "-j", "2"], capsys)
     (line,) = _unknown_layers_line(over_files)
     assert line.endswith(f"; decisions affected: crossing {_pedestrian_states(recordings)}"), line
     assert _unknown_layers_line(over_dataset) == [line]

@@ -226,6 +226,19 @@ def test_planted_walks_match_with_witnesses_and_far_labels_do_not(kind):
     assert not found and notes["follow-start:unsat"] == 1
 
 
+@pytest.mark.parametrize("kind", sorted(KINDS))
+def test_a_wide_tolerance_is_not_refuted_by_the_preimage_of_the_label_alone(kind):
+    """With a 0.5 m tolerance a label 0.3 m off a planted walk's end matches (that walk ends in its
+    box) although the preimage of the label itself may hold no start: the inverted walk refutes
+    only boxes at most 1 mm across and leaves this row to the fallback."""
+    x, y, heading = planted(kind, 0.5, 0.0, 0.0, 0.0)
+    trace = trace_of({"ego": ("Car", 100.0, 0.0, 0.0), "c": ("Car", x + 0.3, y, heading)})
+    options = SceneOptions(Tolerance(0.5, 0.5), correspondence={"c": "c"}, unknown_layers=ANYWHERE)
+    result = query(kind).match(trace, CURB_MAP, options)
+    assert result.matched[0], result.matches.notes
+    assert result.matches.notes["follow-start:unsat"] == 0
+
+
 @settings(max_examples=25, deadline=None, derandomize=True)
 @given(st.floats(0.0, 1.0), st.floats(0.0, 1.0), st.floats(-20.0, 28.0))
 def test_the_preimage_holds_every_walk_ending_at_its_point(where_x, where_y, distance):

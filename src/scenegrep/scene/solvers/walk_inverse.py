@@ -19,9 +19,11 @@ witness. All rows of a call are inverted together (:func:`start_preimages`).
 Refutation: no value the field may take in the end's box (a superset:
 :meth:`~..geometry.MapGeometry.field_headings_in_box`) meets the heading bounds, or no preimage
 segment meets the domain (no start in the domain walks to E: the preimage holds every walk, see
-:mod:`..follow_inverse`). A row whose candidate starts all fail the check (a walk through a cut
-point, or a requirement the start does not meet) is undecided, and the caller decides it by the
-forward enumeration of :mod:`.walk_start` (a curb start) or by the general solvers.
+:mod:`..follow_inverse`) and the end box is at most :data:`REFUTE_BOX_M` across (the preimage
+is the centre's: a walk may end in a wider box elsewhere). A row with a wider box and no preimage
+start, or whose candidate starts all fail the check (a walk through a cut point, or a requirement
+the start does not meet), is undecided, and the caller decides it by the forward enumeration of
+:mod:`.walk_start` (a curb start) or by the general solvers.
 
 Speed (Town01, ``benchmarks/bench_follow.py``, CPU ms per one-frame match, median / p95; refuted =
 the frames moved 3 m or turned 0.3 rad): see the README (section on ``following``), which keeps
@@ -46,6 +48,12 @@ from .branch_prune import Outcome
 from .pointwise import bound_violation, satisfies
 from .problem import Bound, PointUnknown, Problem
 from .walk import ROAD_DIRECTION, _follow_terms, is_end_heading, no_parameters, only_end_box
+
+REFUTE_BOX_M = 1e-3
+"""The preimage, of the end box's centre only, refutes a row when the box's half-diagonal is at
+most this (metres; the default tolerance gives 1.4e-6): a walk may end in a wider box without
+passing through its centre, so a row with a wider box (a real-data tolerance) and no preimage
+start is undecided and goes to the caller's fallback."""
 
 PARALLEL = 1e-9
 """A preimage segment and a curb segment whose directions' sine is below this run along each other."""
@@ -165,7 +173,7 @@ def solve_start_walk(
     else:
         d, sx, sy = _inside(ex, ey, pre, lines, domain)
     if not len(d):
-        return Outcome("unsat", None, "follow-start")
+        return Outcome("unsat" if margin <= REFUTE_BOX_M else "undecided", None, "follow-start")
     end_x, end_y = walk_end(geometry, ROAD_DIRECTION, sx, sy, d, no_parameters)
     ends = (end_x >= x0) & (end_x <= x1) & (end_y >= y0) & (end_y <= y1)
     for k in np.flatnonzero(ends).tolist():

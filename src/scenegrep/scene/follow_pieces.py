@@ -254,9 +254,6 @@ def _ties(lw: Linework, p: np.ndarray, r: np.ndarray, segments: np.ndarray, only
         heading = lw.polylines.heading[lw.pairs[pair]]
         mine = np.any(np.abs(_wrap(heading - only[walk][:, None])) <= ONLY_RAD, axis=1)
         walk, pair = walk[mine], pair[mine]
-    for side in (0, 1):
-        near = shapely.dwithin(segments[walk], lw.segments[lw.pairs[pair, side]], lw.pair_reach[pair])
-        walk, pair = walk[near], pair[near]
     if not len(pair):
         return walk, np.zeros(0), pair
     tie_t, tie = _equal_distances(lw, p[walk], r[walk], pair)

@@ -68,7 +68,7 @@ def case(request, maps_dir, scenic_cache, tmp_path_factory):
     trace = sample_scenes(folder / "simulated.scenic", SCENES, map_path=town, seed=seed)
     write_trace_json(trace, folder / "scenes.json")
     spec = QuerySpec.from_file("scene", folder / "query.scenic", intervals=True)
-    results = query_files([str(folder / "scenes.json")], spec, str(town))
+    results = query_files([str(folder / "scenes.json")], spec)  # the scenes name their map (Town01)
     coverage = coverage_of(results.matches.to_pylist(), variables_of(spec), BINS)
     return coverage, truth_of(trace)
 

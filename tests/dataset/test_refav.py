@@ -18,7 +18,8 @@ from scenegrep.cli.main import main
 from scenegrep.dataset.queries import results_table
 from scenegrep.dataset.refav_export import refav_sequences
 from scenegrep.dataset.refav_format import FORMAT, UNSET, RefFrame, read_sequences, write_sequences
-from scenegrep.dataset.refav_score import evaluate, filter_boxes
+from scenegrep.dataset.refav_score import evaluate, evaluate_files, filter_boxes
+from scenegrep.errors import UserError
 from scenegrep.dataset.results import Results
 from scenegrep.model import LabelTrace, ObjectTable, StateTable
 from tests.conftest import REPO
@@ -221,6 +222,29 @@ def test_evaluate_prints_both_balanced_accuracies(tmp_path, capsys):
     document = json.loads(out)
     assert document["log_balanced_accuracy"] == pytest.approx(2.5 / 3)
     assert [p["prompt"] for p in document["prompts"]] == ["p1", "p2", "p3"]
+
+
+def test_evaluate_files_gives_the_documented_record(tmp_path, capsys):
+    """The Python API's record is what ``evaluate --json`` prints; its counts are the hand-computed ones."""
+    predictions, truth = write_json(tmp_path / "p.json", PREDICTIONS), write_json(tmp_path / "t.json", TRUTH)
+    document = evaluate_files(predictions, truth, max_range_m=30).document()
+    assert document["max_range_m"] == 30 and document["drivable_area_filter"] is False
+    first = document["prompts"][0]
+    assert first["prompt"] == "p1" and [first["timestamp"][k] for k in ("tp", "fp", "fn", "tn")] == [1, 1, 1, 3]
+    assert first["timestamp"]["balanced_accuracy"] == pytest.approx(0.625)
+    code, out, _ = run(["evaluate", predictions, truth, "--json", "--max-range", "30"], capsys)
+    printed = json.loads(out)  # floats to 6 significant digits (scenegrep.json_lines)
+    assert code == 0 and printed.keys() == document.keys() and printed["prompts"][0] == first
+    assert printed["timestamp_balanced_accuracy"] == pytest.approx(document["timestamp_balanced_accuracy"], abs=1e-6)
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -1.0, 0.0])
+def test_evaluate_refuses_a_bad_range_before_reading(tmp_path, bad):
+    """The API refuses what the CLI refuses, with the same one-line message, before any file is read."""
+    with pytest.raises(UserError, match=r"^--max-range \S+: give a positive number of metres$"):
+        evaluate_files(tmp_path / "missing.json", tmp_path / "missing.json", bad)
+    with pytest.raises(UserError, match="give a positive number"):
+        evaluate(PREDICTIONS, TRUTH, bad)
 
 
 def hostile(tmp_path):

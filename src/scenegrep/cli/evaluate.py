@@ -11,11 +11,9 @@ evaluated, 2 user error.
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from typing import Any
 
-from ..errors import UserError
 from ..wording import counted, verb
 
 
@@ -39,27 +37,10 @@ def add_parser(subparsers: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..dataset.refav_format import read_sequences
-    from ..dataset.refav_score import av2_drivable_areas, evaluate
+    from ..dataset.refav_score import evaluate_files
 
-    if not (math.isfinite(args.max_range) and args.max_range > 0):
-        raise UserError(f"--max-range {args.max_range}: give a positive number of metres")
-    predictions = read_sequences(args.predictions)
-    truth = read_sequences(args.ground_truth)
-    drivable = av2_drivable_areas(args.av2) if args.av2 is not None else None
-    result = evaluate(predictions, truth, args.max_range, drivable)
-    document = {
-        "timestamp_balanced_accuracy": result.timestamp_ba,
-        "log_balanced_accuracy": result.log_ba,
-        "prompts": [
-            {"prompt": p.prompt, **{level: _counts(getattr(p, level)) for level in ("timestamp", "log")}}
-            for p in result.prompts
-        ],
-        "boxes_filtered": result.filtered,
-        "max_range_m": args.max_range,
-        "drivable_area_filter": result.filtered and drivable is not None,
-        "unscored_prediction_pairs": result.unscored_pairs,
-    }
+    result = evaluate_files(args.predictions, args.ground_truth, args.max_range, args.av2)
+    document = result.document()
     if args.json:
         from ..json_lines import write
 
@@ -70,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     for scored in document["prompts"]:
         print(f"  {scored['prompt']}: timestamp {_line(scored['timestamp'])}; log {_line(scored['log'])}")
     if result.filtered:
-        area = "and 5 m of the drivable area" if drivable is not None else "(no drivable-area filter: give --av2 DIR)"
+        area = "and 5 m of the drivable area" if result.drivable_area else "(no drivable-area filter: give --av2 DIR)"
         print(f"scenegrep: boxes scored within {args.max_range:g} m of the ego {area}", file=sys.stderr)
     if result.unscored_pairs:
         print(
@@ -79,16 +60,6 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     return 0
-
-
-def _counts(counts: Any) -> dict[str, Any]:
-    return {
-        "balanced_accuracy": counts.balanced_accuracy(),
-        "tp": counts.tp,
-        "fp": counts.fp,
-        "fn": counts.fn,
-        "tn": counts.tn,
-    }
 
 
 def _line(c: dict[str, Any]) -> str:

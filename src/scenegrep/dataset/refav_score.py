@@ -23,16 +23,18 @@ to be equal, so a misaligned submission is an error instead of a wrong score.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import shapely
 
 from ..errors import UserError
 from ..model.geometry import box_corners, heading_from_yaw
-from .refav_format import REFERRED, UNSET, RefFrame, Sequences
+from .refav_format import REFERRED, UNSET, RefFrame, Sequences, read_sequences
 
 MAX_RANGE_M = 50.0
 """RefAV's evaluation range: boxes farther (xy, m) from the ego are not evaluated."""
@@ -76,11 +78,14 @@ class PromptScore:
 @dataclass(frozen=True)
 class Evaluation:
     """The scores: per prompt (ground-truth order), their means, whether the boxes were filtered
-    (a tracking submission), and how many predicted pairs the ground truth does not have."""
+    (a tracking submission), how many predicted pairs the ground truth does not have, the
+    evaluation range (m) and whether a drivable area was given."""
 
     prompts: list[PromptScore]
     filtered: bool
     unscored_pairs: int
+    max_range_m: float = MAX_RANGE_M
+    drivable_area: bool = False
 
     @property
     def timestamp_ba(self) -> float:
@@ -89,6 +94,34 @@ class Evaluation:
     @property
     def log_ba(self) -> float:
         return float(np.mean([p.log.balanced_accuracy() for p in self.prompts])) if self.prompts else 1.0
+
+    def document(self) -> dict[str, Any]:
+        """The scores as one JSON-able record (what ``scenegrep evaluate --json`` prints): both mean
+        balanced accuracies, each prompt's ``timestamp`` and ``log`` counts with their balanced
+        accuracy, ``boxes_filtered``, ``max_range_m``, ``drivable_area_filter`` (the boxes were
+        filtered by a drivable area) and ``unscored_prediction_pairs``."""
+        return {
+            "timestamp_balanced_accuracy": self.timestamp_ba,
+            "log_balanced_accuracy": self.log_ba,
+            "prompts": [
+                {"prompt": p.prompt, **{level: _counts(getattr(p, level)) for level in ("timestamp", "log")}}
+                for p in self.prompts
+            ],
+            "boxes_filtered": self.filtered,
+            "max_range_m": self.max_range_m,
+            "drivable_area_filter": self.filtered and self.drivable_area,
+            "unscored_prediction_pairs": self.unscored_pairs,
+        }
+
+
+def _counts(counts: Counts) -> dict[str, Any]:
+    return {
+        "balanced_accuracy": counts.balanced_accuracy(),
+        "tp": counts.tp,
+        "fp": counts.fp,
+        "fn": counts.fn,
+        "tn": counts.tn,
+    }
 
 
 Region = Callable[[str], shapely.Geometry]
@@ -114,7 +147,9 @@ def evaluate(
     predictions: Sequences, truth: Sequences, max_range_m: float = MAX_RANGE_M, drivable: Region | None = None
 ) -> Evaluation:
     """RefAV's balanced accuracies of ``predictions`` against ``truth`` (module docstring).
-    UserError when a ground-truth pair has no prediction or its frames' timestamps differ."""
+    UserError when ``max_range_m`` is not a positive number, a ground-truth pair has no
+    prediction or its frames' timestamps differ."""
+    check_max_range(max_range_m)
     tracking = any(f.is_positive is UNSET or len(f.track_id) for fs in predictions.values() for f in fs)
     scores: dict[str, PromptScore] = {}
     for key, frames in truth.items():
@@ -133,7 +168,25 @@ def evaluate(
             frames = [filter_boxes(f, max_range_m, area) for f in frames]
             predicted = [filter_boxes(f, max_range_m, area) for f in predicted]
         _count(score, frames, predicted)
-    return Evaluation(list(scores.values()), tracking, len(set(predictions) - set(truth)))
+    unscored = len(set(predictions) - set(truth))
+    return Evaluation(list(scores.values()), tracking, unscored, max_range_m, drivable is not None)
+
+
+def check_max_range(max_range_m: float) -> None:
+    """UserError unless ``max_range_m`` is a finite positive number (of metres)."""
+    if not (math.isfinite(max_range_m) and max_range_m > 0):
+        raise UserError(f"--max-range {max_range_m}: give a positive number of metres")
+
+
+def evaluate_files(
+    predictions: str | Path, truth: str | Path, max_range_m: float = MAX_RANGE_M, av2: str | Path | None = None
+) -> Evaluation:
+    """:func:`evaluate` on two RefAV JSON files (:func:`scenegrep.dataset.refav_format.read_sequences`:
+    UserError for a pickle, a missing or malformed file), with the drivable areas of the AV2 sensor
+    split ``av2`` (:func:`av2_drivable_areas`) when given; ``max_range_m`` is checked first."""
+    check_max_range(max_range_m)
+    drivable = av2_drivable_areas(av2) if av2 is not None else None
+    return evaluate(read_sequences(predictions), read_sequences(truth), max_range_m, drivable)
 
 
 def _count(score: PromptScore, frames: list[RefFrame], predicted: list[RefFrame]) -> None:

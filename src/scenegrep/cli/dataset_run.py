@@ -19,7 +19,6 @@ import json
 import sys
 from collections import Counter
 from collections.abc import Callable, Iterable
-from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -209,27 +208,12 @@ def _value_text(value: Any) -> str:
 
 
 def _nearest_misses(spec: Any, results: Any, args: argparse.Namespace) -> None:
-    """The nearest misses of a Scenic query that matched nothing (:mod:`scenegrep.dataset.misses`):
-    its first traces without a match, read again from the dataset or from their files."""
-    from ..dataset.misses import nearest_misses
+    """Print the nearest misses of a Scenic query that matched nothing (:mod:`scenegrep.dataset.misses`)."""
+    from ..dataset.misses import misses_of_results
     from .misses import print_misses, what_of
 
-    rows = results.table.to_pylist()
-    load = partial(_dataset_trace, Path(args.dataset).resolve()) if args.dataset else partial(_file_trace, rows, args)
-    print_misses(nearest_misses(spec, rows, load), what_of(spec.kind), args.json)
-
-
-def _dataset_trace(root: Path, trace_id: str) -> tuple[Any, Any]:
-    from ..view.sources import load_trace
-
-    return load_trace(root, trace_id)
-
-
-def _file_trace(rows: list[dict[str, Any]], args: argparse.Namespace, trace_id: str) -> tuple[Any, Any]:
-    from ..dataset.files import read_queried_trace
-
-    (source,) = {row["source"] for row in rows if row["trace_id"] == trace_id}
-    return read_queried_trace(source, trace_id, getattr(args, "map", None), getattr(args, "unknown_layers", None))
+    misses = misses_of_results(spec, results, args.dataset, getattr(args, "map", None))
+    print_misses(misses, what_of(spec.kind), args.json)
 
 
 def _report_plan(plan: Any) -> None:

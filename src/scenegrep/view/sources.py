@@ -18,9 +18,10 @@ from typing import Any
 import pyarrow.compute as pc
 
 from .. import readers
-from ..dataset.catalog import CATALOG_FILE, Catalog, catalog_file
+from ..dataset.catalog import CATALOG_FILE, Catalog
 from ..dataset.results import Results
-from ..errors import UserError, at
+from ..dataset.traces import load_trace
+from ..errors import UserError
 from .data import QueryInfo, TraceView, build_view
 from ..wording import numbered
 
@@ -146,22 +147,6 @@ def recorded_query(key: str) -> QueryInfo | None:
         return None
     kind, text, options = json.loads(key)
     return QueryInfo(kind, text, options)
-
-
-def load_trace(root: Path, trace_id: str) -> tuple[Any, Any]:
-    """A dataset's trace and its road map (None without one); UserError for an unknown trace or
-    one whose files the catalog names outside the dataset."""
-    with Catalog(root, read_only=True) as catalog:
-        found = catalog.rows(
-            "SELECT t.file, m.file FROM traces t LEFT JOIN maps m ON t.map_id = m.map_id WHERE t.trace_id = ?",
-            [trace_id],
-        )
-    if not found:
-        raise UserError(f"the dataset has no trace {trace_id!r}", at(root))
-    trace_file, map_file = found[0]
-    trace = readers.read_trace(catalog_file(root, trace_file), "scenegrep-parquet")
-    road_map = None if map_file is None else readers.read_map(catalog_file(root, map_file))
-    return trace, road_map
 
 
 def trace_file_view(path: str | Path, map_path: str | Path | None = None) -> TraceView:

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from scenegrep.cli.main import main
 from scenegrep.dataset.queries import results_table
-from scenegrep.dataset.refav_export import refav_sequences
+from scenegrep.dataset.refav_export import check_request, refav_sequences
 from scenegrep.dataset.refav_format import FORMAT, UNSET, RefFrame, read_sequences, write_sequences
 from scenegrep.dataset.refav_score import evaluate, evaluate_files, filter_boxes
 from scenegrep.errors import UserError
@@ -563,3 +563,19 @@ def test_box_filters_equal_a_brute_force_reference(boxes):
         if math.hypot(x, y) <= 50.0 and near_corner:
             expected.append(str(k))
     assert kept == expected
+
+
+def test_the_api_refuses_what_export_refav_refuses(tmp_path):
+    """The Python API refuses a bad file name and an empty prompt with ``export --refav``'s one-line
+    messages, before anything is written."""
+    for name in ("s.txt", "s.pickle", "s"):
+        with pytest.raises(UserError, match=r"^--refav \S+: write a \.pkl \(RefAV's pickle\) or a \.json file$"):
+            write_sequences({}, tmp_path / name)
+        assert not (tmp_path / name).exists()
+    needs = r"^--refav needs --prompt TEXT: RefAV keys a submission by \(log id, prompt\)$"
+    for prompt in ("", None):
+        with pytest.raises(UserError, match=needs):
+            check_request(tmp_path / "s.json", prompt)
+    with pytest.raises(UserError, match=needs):
+        refav_sequences(results_of([{"status": "no match", "match": -1}]), lambda _: None, "")
+    check_request(tmp_path / "S.PKL", "p")  # the suffix in any case

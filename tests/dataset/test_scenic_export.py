@@ -28,6 +28,7 @@ import pytest
 from scenegrep import readers
 from scenegrep.cli.main import main
 from scenegrep.dataset.moments import Moment, ObjectPath
+from scenegrep.dataset import openscenario_export as ox
 from scenegrep.dataset.scenic_export import scenic_program, write_scenic_programs
 from scenegrep.errors import UserError
 from scenegrep.dataset.ingest import trace_id_of
@@ -417,3 +418,21 @@ def test_round_trip_on_real_recordings(tmp_path, real_data, scenic_compiler, cap
         assert "# No road map: Scenic reads no" in program.read_text()
     print(f"real: {len(errors)} programs, largest position error {max(errors):.3g} m")
     assert max(errors) <= 0.5
+
+
+@pytest.mark.parametrize(
+    ("write", "option"), [(write_scenic_programs, "--scenic"), (ox.write_openscenario, "--openscenario")]
+)
+def test_writers_refuse_what_export_refuses_before_reading_a_moment(write, option, tmp_path):
+    """Both exporters' Python API refuses a blank folder name or a file with the CLI's one-line
+    message, before it asks for the first moment."""
+
+    def no_moments():
+        raise AssertionError("a moment was read")
+        yield
+
+    (tmp_path / "file").write_text("")
+    with pytest.raises(UserError, match=rf"^{option}: give the folder to write to$"):
+        write(no_moments(), " ")
+    with pytest.raises(UserError, match=rf"^{option} \S+file: not a directory \(one file per match is written"):
+        write(no_moments(), tmp_path / "file")

@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
@@ -82,14 +81,11 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _refav(args: argparse.Namespace) -> int:
-    from ..dataset.refav_export import refav_sequences
+    from ..dataset.refav_export import check_request, refav_sequences
     from ..dataset.refav_format import write_sequences
     from ..view.sources import ResultsSource
 
-    if Path(args.refav).suffix.lower() not in (".pkl", ".json"):
-        raise UserError(f"--refav {args.refav}: write a .pkl (RefAV's pickle) or a .json file")
-    if not args.prompt:
-        raise UserError("--refav needs --prompt TEXT: RefAV keys a submission by (log id, prompt)")
+    check_request(args.refav, args.prompt)
     source = ResultsSource.open(args.results, args.dataset)
     sequences = refav_sequences(source.results, lambda trace_id: source.load(trace_id)[0], args.prompt, args.referred)
     write_sequences(sequences, args.refav)
@@ -109,15 +105,12 @@ def _moments(args: argparse.Namespace, option: str, folder: str) -> Iterator[Any
     """The preamble of ``--openscenario`` and ``--scenic``: the options checked, the output folder
     checked (UserError for an empty name or a file), the results opened, what they leave unknown
     said on stderr (failed traces, an interrupted run: no moments there), and the moments."""
-    from ..dataset.moments import moments
+    from ..dataset.moments import check_output_folder, moments
     from ..view.sources import ResultsSource
 
     if args.prompt is not None or args.referred is not None:
         raise UserError("--prompt and --referred go with --refav")
-    if not folder.strip():
-        raise UserError(f"{option}: give the folder to write to")
-    if Path(folder).exists() and not Path(folder).is_dir():
-        raise UserError(f"{option} {folder}: not a directory (one file per match is written into a directory)")
+    check_output_folder(folder, option)
     source = ResultsSource.open(args.results, args.dataset)
     failed = source.results.counts()["failed"]
     if not args.quiet and failed:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -67,6 +68,16 @@ class Moment:
     objects: tuple[ObjectPath, ...]
     duration: float = 0.0
     frame_period: float = 0.1
+
+
+def check_output_folder(folder: str | Path, option: str) -> None:
+    """The folder an exporter of moments writes one file per match into, checked before anything
+    is read: UserError (naming ``option``, e.g. ``--scenic``) for an empty or blank name, or a path
+    that exists and is not a directory."""
+    if not str(folder).strip():
+        raise UserError(f"{option}: give the folder to write to")
+    if Path(folder).exists() and not Path(folder).is_dir():
+        raise UserError(f"{option} {folder}: not a directory (one file per match is written into a directory)")
 
 
 def moments(results: Results, load: Callable[[str], LabelTrace], context: float | None = None) -> Iterator[Moment]:

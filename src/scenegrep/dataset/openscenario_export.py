@@ -50,7 +50,7 @@ from ..model.geometry import yaw_from_heading
 from ..model.taxonomy import kind_of
 from ..writers.atomic import atomic_path
 from ..writers.file_names import file_stem
-from .moments import Moment, ObjectPath
+from .moments import Moment, ObjectPath, check_output_folder
 
 OSC_MINOR_VERSION = 3
 """The files are OpenSCENARIO 1.3."""
@@ -160,7 +160,9 @@ def write_openscenario(
 ) -> ExportSummary:
     """Write every moment as ``out_dir/<file_name>`` (atomically), each after it validated
     against the XSD; UserError, with nothing more written, at the first file that does not.
-    ``created`` is the FileHeader date (default: now, the same for every file)."""
+    ``created`` is the FileHeader date (default: now, the same for every file). UserError first
+    for an ``out_dir`` that cannot be a folder (:func:`scenegrep.dataset.moments.check_output_folder`)."""
+    check_output_folder(out_dir, "--openscenario")
     folder = Path(out_dir)
     created = created or dt.datetime.now().replace(microsecond=0)
     summary = ExportSummary()

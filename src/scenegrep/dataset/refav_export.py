@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -26,7 +27,7 @@ import numpy as np
 from ..errors import UserError
 from ..model import LabelTrace
 from ..model.geometry import yaw_from_heading
-from .refav_format import REFERRED, RefFrame, Sequences
+from .refav_format import REFERRED, RefFrame, Sequences, check_submission_path
 from .results import Results
 
 AV2_SENSOR = "argoverse2-sensor"
@@ -36,11 +37,27 @@ EVALUATION_STRIDE = 5
 """RefAV evaluates every 5th frame of a 10 Hz log (2 Hz)."""
 
 
+def check_request(path: str | Path, prompt: str | None) -> None:
+    """The checks of a submission request before any result is read: ``path`` names a ``.pkl`` or
+    ``.json`` file (:func:`scenegrep.dataset.refav_format.check_submission_path`) and ``prompt`` is
+    not empty; UserError otherwise."""
+    check_submission_path(path)
+    check_prompt(prompt)
+
+
+def check_prompt(prompt: str | None) -> None:
+    """UserError for no prompt or an empty one (RefAV keys a submission by log id and prompt)."""
+    if not prompt:
+        raise UserError("--refav needs --prompt TEXT: RefAV keys a submission by (log id, prompt)")
+
+
 def refav_sequences(
     results: Results, load: Callable[[str], LabelTrace], prompt: str, referred: str | None = None
 ) -> Sequences:
     """The RefAV sequences of ``results`` for ``prompt`` (module docstring); ``load`` gives a
-    trace of the table by trace id. UserError for what RefAV cannot be given."""
+    trace of the table by trace id. UserError for what RefAV cannot be given (an empty prompt
+    first: :func:`check_request`)."""
+    check_prompt(prompt)
     if results.status != "finished":
         raise UserError(f"the run is {results.status}: its results are partial, so a RefAV submission would be wrong")
     rows = results.table.to_pylist()

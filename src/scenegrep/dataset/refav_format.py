@@ -120,11 +120,19 @@ Sequences = dict[tuple[str, str], list[RefFrame]]
 """(log id, prompt) -> its frames, in time order."""
 
 
+def check_submission_path(path: str | Path) -> None:
+    """UserError unless ``path`` ends in ``.pkl`` (RefAV's pickle) or ``.json`` (any case)."""
+    if Path(path).suffix.lower() not in (".pkl", ".json"):
+        raise UserError(f"--refav {path}: write a .pkl (RefAV's pickle) or a .json file")
+
+
 def write_sequences(sequences: Sequences, path: str | Path) -> None:
-    """Write ``sequences`` atomically: RefAV's pickle when ``path`` ends in ``.pkl``, else JSON."""
+    """Write ``sequences`` atomically: RefAV's pickle when ``path`` ends in ``.pkl``, JSON when it
+    ends in ``.json`` (UserError for any other name: :func:`check_submission_path`)."""
     from ..writers.atomic import atomic_path
 
-    if Path(path).suffix.lower() in (".pkl", ".pickle"):
+    check_submission_path(path)
+    if Path(path).suffix.lower() == ".pkl":
         data = {key: [frame.as_refav() for frame in frames] for key, frames in sequences.items()}
         content = pickle.dumps(data, protocol=4)
     else:

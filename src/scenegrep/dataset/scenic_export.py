@@ -51,7 +51,7 @@ import numpy as np
 from ..errors import UserError
 from ..writers.file_names import file_stem
 from ..model.taxonomy import kind_of
-from .moments import Moment, ObjectPath
+from .moments import Moment, ObjectPath, check_output_folder
 
 SCENIC_VERSION = "3.1.1"
 """The Scenic version the programs are written for (the pinned one)."""
@@ -156,9 +156,11 @@ def scenic_program(moment: Moment, map_reference: str | None, without_map: str |
 def write_scenic_programs(moments: Iterable[Moment], folder: str | Path) -> list[WrittenProgram]:
     """Write every moment's program into ``folder`` (created if needed), each as
     ``<trace name>-<match>.scenic`` with the name reduced to letters, digits, ``.``, ``_`` and
-    ``-`` (a name two traces share gets the trace id's digest too), written atomically."""
+    ``-`` (a name two traces share gets the trace id's digest too), written atomically. UserError
+    first for a ``folder`` that cannot be one (:func:`scenegrep.dataset.moments.check_output_folder`)."""
     from ..writers.atomic import atomic_path
 
+    check_output_folder(folder, "--scenic")
     folder = Path(folder)
     written: list[WrittenProgram] = []
     owners: dict[str, str] = {}

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 from scenegrep.cli.main import main
 from scenegrep.dataset.queries import results_table
 from scenegrep.dataset.refav_export import check_request, refav_sequences
-from scenegrep.dataset.refav_format import FORMAT, UNSET, RefFrame, read_sequences, write_sequences
+from scenegrep.dataset.refav_format import FORMAT, UNSET, RefFrame, read_sequences, sequence_counts, write_sequences
 from scenegrep.dataset.refav_score import evaluate, evaluate_files, filter_boxes
 from scenegrep.errors import UserError
 from scenegrep.dataset.results import Results
@@ -579,3 +579,9 @@ def test_the_api_refuses_what_export_refav_refuses(tmp_path):
     with pytest.raises(UserError, match=needs):
         refav_sequences(results_of([{"status": "no match", "match": -1}]), lambda _: None, "")
     check_request(tmp_path / "S.PKL", "p")  # the suffix in any case
+
+
+def test_sequence_counts_counts_sequences_boxed_sequences_and_frames():
+    boxed = [frame(0), frame(1, boxes=[(1, 0, 0, "t")])]
+    assert sequence_counts({("a", "p"): boxed, ("b", "p"): [frame(0)], ("a", "q"): []}) == (3, 1, 3)
+    assert sequence_counts({}) == (0, 0, 0)

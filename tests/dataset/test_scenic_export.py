@@ -29,7 +29,7 @@ from scenegrep import readers
 from scenegrep.cli.main import main
 from scenegrep.dataset.moments import Moment, ObjectPath
 from scenegrep.dataset import openscenario_export as ox
-from scenegrep.dataset.scenic_export import scenic_program, write_scenic_programs
+from scenegrep.dataset.scenic_export import WrittenProgram, scenic_program, without_map_counts, write_scenic_programs
 from scenegrep.errors import UserError
 from scenegrep.dataset.ingest import trace_id_of
 from scenegrep.dataset.queries import results_table
@@ -436,3 +436,9 @@ def test_writers_refuse_what_export_refuses_before_reading_a_moment(write, optio
         write(no_moments(), " ")
     with pytest.raises(UserError, match=rf"^{option} \S+file: not a directory \(one file per match is written"):
         write(no_moments(), tmp_path / "file")
+
+
+def test_without_map_counts_group_by_reason_in_order(tmp_path):
+    written = [WrittenProgram(tmp_path / f"{n}.scenic", reason) for n, reason in enumerate(["z", None, "a", "z"])]
+    assert list(without_map_counts(written).items()) == [("a", 1), ("z", 2)]
+    assert without_map_counts([]) == {}

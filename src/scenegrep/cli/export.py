@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
 
 def _refav(args: argparse.Namespace) -> int:
     from ..dataset.refav_export import check_request, refav_sequences
-    from ..dataset.refav_format import write_sequences
+    from ..dataset.refav_format import sequence_counts, write_sequences
     from ..view.sources import ResultsSource
 
     check_request(args.refav, args.prompt)
@@ -90,10 +90,9 @@ def _refav(args: argparse.Namespace) -> int:
     sequences = refav_sequences(source.results, lambda trace_id: source.load(trace_id)[0], args.prompt, args.referred)
     write_sequences(sequences, args.refav)
     if not args.quiet:
-        positive = sum(any(len(f.label) for f in frames) for frames in sequences.values())
-        frames = sum(len(frames) for frames in sequences.values())
+        logs, positive, frames = sequence_counts(sequences)
         print(
-            f"scenegrep: {counted(len(sequences), 'log')} ({positive} with a referred track), "
+            f"scenegrep: {counted(logs, 'log')} ({positive} with a referred track), "
             f"{counted(frames, 'evaluation timestamp')} "
             f"written to {args.refav}",
             file=sys.stderr,
@@ -160,12 +159,11 @@ def _openscenario(args: argparse.Namespace) -> int:
 
 
 def _scenic(args: argparse.Namespace) -> int:
-    from ..dataset.scenic_export import write_scenic_programs
+    from ..dataset.scenic_export import without_map_counts, write_scenic_programs
 
     written = write_scenic_programs(_moments(args, "--scenic", args.scenic), args.scenic)
     if not args.quiet:
-        for reason in sorted({w.without_map for w in written if w.without_map}):
-            count = sum(w.without_map == reason for w in written)
+        for reason, count in without_map_counts(written).items():
             print(
                 f"scenegrep: {counted(count, 'program')} without a road map ({reason}): objects placed without roads",
                 file=sys.stderr,

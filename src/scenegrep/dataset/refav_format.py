@@ -120,6 +120,13 @@ Sequences = dict[tuple[str, str], list[RefFrame]]
 """(log id, prompt) -> its frames, in time order."""
 
 
+def sequence_counts(sequences: Sequences) -> tuple[int, int, int]:
+    """How many (log id, prompt) sequences there are, how many of them have a box in some frame,
+    and how many frames (evaluation timestamps) they hold in all."""
+    boxed = sum(any(len(frame.label) for frame in frames) for frames in sequences.values())
+    return len(sequences), boxed, sum(len(frames) for frames in sequences.values())
+
+
 def check_submission_path(path: str | Path) -> None:
     """UserError unless ``path`` ends in ``.pkl`` (RefAV's pickle) or ``.json`` (any case)."""
     if Path(path).suffix.lower() not in (".pkl", ".json"):

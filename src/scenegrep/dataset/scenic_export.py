@@ -42,6 +42,7 @@ import json
 import math
 import os
 import re
+from collections import Counter
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -127,6 +128,11 @@ class WrittenProgram:
 
     path: Path
     without_map: str | None
+
+
+def without_map_counts(written: list[WrittenProgram]) -> dict[str, int]:
+    """Reason -> how many of the programs ``written`` have no road map for it, by reason (sorted)."""
+    return dict(sorted(Counter(w.without_map for w in written if w.without_map).items()))
 
 
 def scenic_program(moment: Moment, map_reference: str | None, without_map: str | None = None) -> str:

@@ -27,7 +27,7 @@ import pytest
 
 from scenegrep import readers
 from scenegrep.cli.main import main
-from scenegrep.dataset.moments import Moment, ObjectPath
+from scenegrep.dataset.moments import Moment, ObjectPath, left_out
 from scenegrep.dataset import openscenario_export as ox
 from scenegrep.dataset.scenic_export import WrittenProgram, scenic_program, without_map_counts, write_scenic_programs
 from scenegrep.errors import UserError
@@ -264,6 +264,13 @@ def test_failed_traces_and_interrupted_runs_are_said_not_silently_skipped(target
     assert code == 0 and "1 match written" in err, err
     assert "1 trace failed" in err and "none exported" in err and "an interrupted run" in err
     assert len(list((tmp_path / "out").iterdir())) == 1
+    assert left_out(Results(results_table([row, failed, failed | {"trace_id": "g2"}]), "run"), "R") == [
+        "2 traces failed in R: their matches are unknown, none exported"
+    ]
+    assert left_out(Results(results_table([row]), "run", "interrupted"), "R") == [
+        "R is an interrupted run: the traces it did not reach are not exported"
+    ]
+    assert left_out(Results(results_table([row]), "run"), "R") == []
 
 
 def street_trace():

@@ -104,24 +104,15 @@ def _moments(args: argparse.Namespace, option: str, folder: str) -> Iterator[Any
     """The preamble of ``--openscenario`` and ``--scenic``: the options checked, the output folder
     checked (UserError for an empty name or a file), the results opened, what they leave unknown
     said on stderr (failed traces, an interrupted run: no moments there), and the moments."""
-    from ..dataset.moments import check_output_folder, moments
+    from ..dataset.moments import check_output_folder, left_out, moments
     from ..view.sources import ResultsSource
 
     if args.prompt is not None or args.referred is not None:
         raise UserError("--prompt and --referred go with --refav")
     check_output_folder(folder, option)
     source = ResultsSource.open(args.results, args.dataset)
-    failed = source.results.counts()["failed"]
-    if not args.quiet and failed:
-        print(
-            f"scenegrep: {counted(failed, 'trace')} failed in {args.results}: their matches are unknown, none exported",
-            file=sys.stderr,
-        )
-    if not args.quiet and source.results.status == "interrupted":
-        print(
-            f"scenegrep: {args.results} is an interrupted run: the traces it did not reach are not exported",
-            file=sys.stderr,
-        )
+    for sentence in [] if args.quiet else left_out(source.results, args.results):
+        print(f"scenegrep: {sentence}", file=sys.stderr)
     return moments(source.results, lambda trace_id: source.load(trace_id)[0], args.context)
 
 

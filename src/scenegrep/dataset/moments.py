@@ -24,6 +24,7 @@ import numpy as np
 from ..errors import UserError
 from ..model import LabelTrace
 from ..model.trace import MapSource
+from ..wording import counted
 from .results import Results
 
 MAX_CONTEXT_M = 1000.0
@@ -78,6 +79,17 @@ def check_output_folder(folder: str | Path, option: str) -> None:
         raise UserError(f"{option}: give the folder to write to")
     if Path(folder).exists() and not Path(folder).is_dir():
         raise UserError(f"{option} {folder}: not a directory (one file per match is written into a directory)")
+
+
+def left_out(results: Results, name: str) -> list[str]:
+    """What an export of the moments of ``results`` (called ``name`` in the text, e.g. its file)
+    cannot hold, one sentence each: the failed traces (their matches are unknown) and, for an
+    interrupted run, the traces it did not reach. Empty when nothing is left out."""
+    failed = results.counts()["failed"]
+    said = [f"{counted(failed, 'trace')} failed in {name}: their matches are unknown, none exported"] if failed else []
+    if results.status == "interrupted":
+        said.append(f"{name} is an interrupted run: the traces it did not reach are not exported")
+    return said
 
 
 def moments(results: Results, load: Callable[[str], LabelTrace], context: float | None = None) -> Iterator[Moment]:

@@ -53,6 +53,7 @@ import shapely
 from .follow import MIN_STEPS, STEP_M, steps_for
 from ..model.polylines import Polylines
 from .geometry import ELEMENT_REACH_M, MapGeometry
+from .heading_index import HeadingIndex, heading_index, near_heading
 from .regions import Field
 
 REACH_MARGIN_M = 1.0
@@ -85,7 +86,9 @@ class Linework:
     pairs of centreline segments of one lane that may compete for a point, with an
     R-tree of the boxes where they may (within the lane's reach of both); the centreline segments
     as lines; an R-tree of where a lane's direction may count at all (each lane grown by Scenic's
-    tolerance, and the intersection areas, where the nearest lane may count)."""
+    tolerance, and the intersection areas, where the nearest lane may count). For cuts for one
+    heading (:func:`crossings` with ``only``): the area boundaries (indices into the segments) with
+    their own R-tree, and the vertex lines and the pairs indexed by heading."""
 
     start: np.ndarray
     end: np.ndarray
@@ -98,6 +101,10 @@ class Linework:
     polylines: Polylines
     segments: np.ndarray
     lane_reach: shapely.STRtree
+    boundary: np.ndarray
+    boundary_tree: shapely.STRtree
+    line_index: HeadingIndex
+    pair_index: HeadingIndex
 
 
 class _Columns:
@@ -163,7 +170,26 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     near = reach[lanes] + REACH_MARGIN_M
     segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
     lane_reach = shapely.STRtree(np.append(shapely.buffer(road_map.lane_polygons, ELEMENT_REACH_M), intersections))
-    return Linework(start, end, side, tree, pairs, lanes, near, shapely.STRtree(boxes), polylines, segments, lane_reach)
+    boundary = np.flatnonzero(np.isnan(side[:, 0]))
+    line_index = heading_index(side, shapely.bounds(tree.geometries))
+    pair_index = heading_index(polylines.heading[pairs], shapely.bounds(boxes))
+    return Linework(
+        start,
+        end,
+        side,
+        tree,
+        pairs,
+        lanes,
+        near,
+        shapely.STRtree(boxes),
+        polylines,
+        segments,
+        lane_reach,
+        boundary,
+        shapely.STRtree(tree.geometries[boundary]),
+        line_index,
+        pair_index,
+    )
 
 
 def _competing_pairs(polylines: Polylines, reach: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -218,18 +244,31 @@ def crossings(lw: Linework, px, py, qx, qy, only=None) -> tuple[np.ndarray, np.n
     p = np.stack([px, py], 1)[index]
     r = np.stack([qx, qy], 1)[index] - p
     segments = shapely.linestrings(np.stack([p, p + r], axis=1))
-    walk, line = lw.tree.query(segments)
-    if only is not None:
-        side = lw.side[line]
-        near = np.abs(_wrap(side - np.asarray(only)[index][walk][:, None])) <= ONLY_RAD
-        mine = np.isnan(side[:, 0]) | np.any(near, axis=1)
-        walk, line = walk[mine], line[mine]
+    if only is None:
+        walk, line = lw.tree.query(segments)
+    else:
+        walk, line = _lines_for(lw, p, r, segments, np.asarray(only)[index])
     found_walk, found_t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
     tie_walk, tie_t, _ = _ties(lw, p, r, segments, None if only is None else np.asarray(only)[index])
     found_walk = np.concatenate([walk[found_walk], tie_walk])
     found_t = np.concatenate([found_t, tie_t])
     inside = (found_t > 0) & (found_t < 1)
     return index[found_walk[inside]], found_t[inside]
+
+
+def _lines_for(lw: Linework, p, r, segments, only) -> tuple[np.ndarray, np.ndarray]:
+    """(segment index, line index) of the linework lines whose boxes meet segment i's (as the
+    R-tree finds them) and that may change the heading to or from ``only[i]``: every area boundary,
+    and the vertex lines with a segment of that heading either side."""
+    walk, edge = lw.boundary_tree.query(segments)
+    near_walk, line = near_heading(lw.line_index, only, _bounds(p, r))
+    near = np.any(np.abs(_wrap(lw.side[line] - only[near_walk][:, None])) <= ONLY_RAD, axis=1)
+    return np.concatenate([walk, near_walk[near]]), np.concatenate([lw.boundary[edge], line[near]])
+
+
+def _bounds(p: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """The boxes (rows of x_min, y_min, x_max, y_max) of the segments from p to p + r."""
+    return np.concatenate([np.minimum(p, p + r), np.maximum(p, p + r)], axis=1)
 
 
 def ties(lw: Linework, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -249,8 +288,10 @@ def ties(lw: Linework, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, 
 def _ties(lw: Linework, p: np.ndarray, r: np.ndarray, segments: np.ndarray, only=None):
     """(segment index, t, pair index) where the two segments of a competing pair are equally near
     p + t r (with ``only``: pairs one of whose segments has heading ``only[segment index]``)."""
-    walk, pair = lw.pair_tree.query(segments)
-    if only is not None:
+    if only is None:
+        walk, pair = lw.pair_tree.query(segments)
+    else:
+        walk, pair = near_heading(lw.pair_index, only, _bounds(p, r))
         heading = lw.polylines.heading[lw.pairs[pair]]
         mine = np.any(np.abs(_wrap(heading - only[walk][:, None])) <= ONLY_RAD, axis=1)
         walk, pair = walk[mine], pair[mine]

@@ -1,0 +1,103 @@
+"""The cuts for one heading (:func:`scenegrep.scene.follow_pieces.crossings` with ``only``) found
+through the heading index (:mod:`scenegrep.scene.heading_index`) are exactly those of the R-tree
+query followed by the heading test (the inverted walk's step before the index, written out here
+as the reference): on random items against a brute-force pass over every (query, item) pair, and
+as the preimages of random Town01 walk ends (the same starts, D intervals and headings)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from scenegrep.scene import follow_pieces
+from scenegrep.scene.follow import walk_end
+from scenegrep.scene.follow_inverse import preimages
+from scenegrep.scene.follow_pieces import ONLY_RAD, _equal_distances, _segment_crossings, _wrap
+from scenegrep.scene.heading_index import WINDOW_RAD, heading_index, near_heading
+from tests.scene.test_follow import FIELD
+from tests.scene.test_follow_start import town01
+
+ANGLES = st.sampled_from([0.0, 1e-7, -1e-7, np.pi / 2, np.pi, -np.pi, 2 * np.pi - 1e-9, 3.0, np.nan])
+
+
+def boxes(draw, n: int) -> np.ndarray:
+    corner = np.array(draw(st.lists(st.tuples(*[st.integers(-40, 40)] * 2), min_size=n, max_size=n)), float).reshape(
+        n, 2
+    )
+    size = np.array(draw(st.lists(st.tuples(*[st.integers(0, 20)] * 2), min_size=n, max_size=n)), float).reshape(n, 2)
+    return np.concatenate([corner, corner + size], axis=1)
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(st.data(), st.integers(0, 12), st.integers(0, 8))
+def test_near_heading_finds_every_item_near_in_heading_and_box_once(data, items, queries):
+    """Brute force: every (query, item) whose boxes meet (closed) and one of whose headings lies within
+    WINDOW_RAD of the query's, modulo 2π (headings at the wrap, NaN columns, touching boxes)."""
+    headings = np.array(data.draw(st.lists(st.tuples(ANGLES, ANGLES), min_size=items, max_size=items)), float)
+    index = heading_index(headings.reshape(items, 2), boxes(data.draw, items))
+    asked = np.array(data.draw(st.lists(ANGLES.filter(lambda a: a == a), min_size=queries, max_size=queries)), float)
+    where = boxes(data.draw, queries)
+    found = set(zip(*(a.tolist() for a in near_heading(index, asked, where))))
+    expected = {
+        (q, i)
+        for q in range(queries)
+        for i in range(items)
+        if np.all(where[q, :2] <= index.bounds[i, 2:])
+        and np.all(index.bounds[i, :2] <= where[q, 2:])
+        and np.any(np.abs(_wrap(headings.reshape(items, 2)[i] - asked[q])) <= WINDOW_RAD)
+    }
+    assert found == expected
+
+
+def reference_crossings(lw, px, py, qx, qy, only=None):
+    """The cuts as the inverted walk found them before the heading index: every line and pair whose
+    box meets the swept segment's (R-tree), then those with the heading tried."""
+    index = np.flatnonzero(np.hypot(qx - px, qy - py) > follow_pieces.DEGENERATE_M)
+    p = np.stack([px, py], 1)[index]
+    r = np.stack([qx, qy], 1)[index] - p
+    only = np.asarray(only)[index]
+    segments = shapely.linestrings(np.stack([p, p + r], axis=1))
+    walk, line = lw.tree.query(segments)
+    side = lw.side[line]
+    mine = np.isnan(side[:, 0]) | np.any(np.abs(_wrap(side - only[walk][:, None])) <= ONLY_RAD, axis=1)
+    walk, line = walk[mine], line[mine]
+    hit, t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
+    pair_walk, pair = lw.pair_tree.query(segments)
+    heading = lw.polylines.heading[lw.pairs[pair]]
+    mine = np.any(np.abs(_wrap(heading - only[pair_walk][:, None])) <= ONLY_RAD, axis=1)
+    pair_walk, pair = pair_walk[mine], pair[mine]
+    tie_t, tie = _equal_distances(lw, p[pair_walk], r[pair_walk], pair) if len(pair) else (np.zeros(0), pair)
+    found_walk = np.concatenate([walk[hit], pair_walk[tie]])
+    found_t = np.concatenate([t, tie_t])
+    inside = (found_t > 0) & (found_t < 1)
+    return index[found_walk[inside]], found_t[inside]
+
+
+def rows(pre) -> list[tuple]:
+    first = np.nan_to_num(pre.first, nan=9.0)
+    return sorted(zip(*(a.tolist() for a in (pre.row, pre.lo, pre.hi, pre.steps, pre.ax, pre.ay, first))))
+
+
+@pytest.mark.real_data
+def test_town01_preimages_equal_those_of_the_r_tree_step(monkeypatch):
+    """The preimages of 150 Town01 walk ends (random starts near the roads, D forwards and backwards,
+    the first heading checked and not) equal, row for row, those with the reference's cuts."""
+    found = town01()
+    if found is None:
+        pytest.skip("../shared/maps/Town01.xodr is absent")
+    geometry, roads = found
+    rng = np.random.default_rng(15)
+    x0, y0, x1, y1 = roads.bounds
+    points = shapely.points(rng.uniform(x0, x1, 3000), rng.uniform(y0, y1, 3000))
+    x, y = shapely.get_coordinates(points[shapely.dwithin(points, roads, 2.0)][:150]).T
+    distance = np.where(rng.random(len(x)) < 0.5, rng.uniform(-30, -20, len(x)), rng.uniform(10, 20, len(x)))
+    ex, ey = walk_end(geometry, FIELD, x, y, distance, None)
+    lo, hi = np.where(distance < 0, -30.0, 10.0), np.where(distance < 0, -20.0, 20.0)
+    new = [rows(preimages(geometry, FIELD, ex, ey, lo, hi, check)) for check in (True, False)]
+    monkeypatch.setattr(follow_pieces, "crossings", reference_crossings)
+    old = [rows(preimages(geometry, FIELD, ex, ey, lo, hi, check)) for check in (True, False)]
+    assert new == old
+    assert len(new[0]) >= len(x)

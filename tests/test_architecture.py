@@ -45,7 +45,16 @@ LAYERS: tuple[tuple[str, ...], ...] = (
 
 SCENE_LAYERS: tuple[tuple[str, ...], ...] = (
     ("terms", "regions", "values", "vectors", "domain", "program"),  # the term language
-    ("geometry", "shapes", "unknown", "follow", "follow_pieces", "follow_regions", "follow_inverse"),  # map geometry
+    (
+        "geometry",
+        "shapes",
+        "unknown",
+        "follow",
+        "follow_pieces",
+        "follow_regions",
+        "follow_inverse",
+        "heading_index",
+    ),  # map geometry
     ("context", "expressions", "specifiers", "lenient_boxes", "resolve", "needs"),  # syntax, specifier semantics
     ("dependencies", "randoms", "evaluate"),  # analysis and evaluation
     ("tolerance", "decide", "solvers"),  # the decision procedures

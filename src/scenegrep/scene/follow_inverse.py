@@ -309,7 +309,11 @@ def _within(ex, ey, b: _Back, branch, heading, near, roads) -> tuple[np.ndarray,
     meet = np.flatnonzero(np.all((np.minimum(p, q) <= high) & (np.maximum(p, q) >= low), axis=1))
     t_lo, t_hi = np.full(len(p), np.inf), np.full(len(p), -np.inf)
     t_lo[meet], t_hi[meet] = _stadium(p[meet], (q - p)[meet], ends[meet, :2], ends[meet, 2:], reach[meet])
-    return np.where(t_lo <= t_hi, lo + t_lo * (hi - lo), np.inf), lo + t_hi * (hi - lo)
+    hit = np.flatnonzero(t_lo <= t_hi)  # elsewhere t_hi may be -inf, and -inf * 0 (a point interval) is NaN
+    start, end = np.full(len(p), np.inf), np.full(len(p), -np.inf)
+    start[hit] = lo[hit] + t_lo[hit] * (hi[hit] - lo[hit])
+    end[hit] = lo[hit] + t_hi[hit] * (hi[hit] - lo[hit])
+    return start, end
 
 
 def _stadium(p, r, a, b, radius) -> tuple[np.ndarray, np.ndarray]:

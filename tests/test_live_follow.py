@@ -156,7 +156,9 @@ def test_scenario_follow_prints_each_window_within_100ms_of_its_last_frame(files
     args = ["scenario", FIG1, "--window", "3", "--map", str(files / "map.parquet"), "--all"]
     run = follow(files, "scenario", trace_messages(), args, pause=0.15)
     assert run.code == 0, run.err
-    assert [line for line, _ in run.lines] == offline and len(offline) == 3
+    live = [line for line, _ in run.lines]
+    source = str(files / "table2.json")  # each line's SOURCE#: the followed file's, as given
+    assert [line.replace(source, str(files / "scenario.mcap"), 1) for line in offline] == live and len(offline) == 3
     assert_in_time(run, lambda line: int(line.split()[0].rsplit("-", 1)[1]))
     assert "scenegrep: latency: 5 frames, median " in run.err and "; 3 matches, median " in run.err
 
@@ -232,12 +234,12 @@ def stdin_run(monkeypatch, capsys, data: bytes, args: list[str]) -> tuple[int, l
 def test_mcap_on_standard_input_with_other_topics_noted(monkeypatch, capsys, files):
     data = mcap_file(strem_messages(), noise=True)
     code, lines, err = stdin_run(monkeypatch, capsys, data, ["spre", "--online", "[[:car:]][[:pedestrian:]]"])
-    assert (code, lines) == (0, ["1-2", "4-5", "7-8"])
+    assert (code, lines) == (0, ["-:1-2", "-:4-5", "-:7-8"])
     assert err.count("note: skipped topics of unsupported types: /noise") == 1 and "latency" not in err
     data = mcap_file(trace_messages())
     args = ["scenario", FIG1, "--online", "--window", "3", "--map", str(files / "map.parquet")]
     code, lines, _ = stdin_run(monkeypatch, capsys, data, args)
-    assert code == 0 and [line.split()[0] for line in lines] == ["table2:0-2", "table2:1-3", "table2:2-4"]
+    assert code == 0 and [line.split()[0] for line in lines] == ["-#table2:0-2", "-#table2:1-3", "-#table2:2-4"]
 
 
 @pytest.mark.parametrize(
@@ -264,7 +266,7 @@ def test_a_bad_document_in_a_message_names_its_topic_and_log_time(monkeypatch, c
     bad = RawMessage("/detections", STREM_SCHEMA, "", b"", "json", 3 * 10**8, b'{"version": "0.2.0", "frames": [{')
     messages = strem_messages()[:3] + [bad]
     code, lines, err = stdin_run(monkeypatch, capsys, mcap_file(messages), ["spre", "--online", "[[:car:]]"])
-    assert code == 2 and lines == ["0-0", "1-1"] and err.startswith("scenegrep: error: /detections @ 300000000 ns")
+    assert code == 2 and lines == ["-:0-0", "-:1-1"] and err.startswith("scenegrep: error: /detections @ 300000000 ns")
 
 
 def test_latency_line_gives_median_and_p99_in_milliseconds():
@@ -282,7 +284,7 @@ def test_detection2d_messages_on_stdin_give_the_stream_answers(conformance_dir, 
     stream = conformance_dir / "strem/data/seq_a.json"
     write_detections2d(readers.read_trace(stream), tmp_path / "boxes.mcap")
     main(["spre", "--online", pattern, str(stream)])
-    expected = [line.rsplit(":", 1)[1] for line in capsys.readouterr().out.splitlines()]
+    expected = ["-:" + line.rsplit(":", 1)[1] for line in capsys.readouterr().out.splitlines()]
     code, lines, _ = stdin_run(
         monkeypatch, capsys, (tmp_path / "boxes.mcap").read_bytes(), ["spre", "--online", pattern]
     )
@@ -300,7 +302,7 @@ def test_a_second_camera_arriving_after_the_frame_topic_is_dropped_with_a_note(
     main(["spre", "--online", ".", str(tmp_path / "two.mcap")])
     offline = [line.rsplit(":", 1)[1] for line in capsys.readouterr().out.splitlines()]
     code, lines, err = stdin_run(monkeypatch, capsys, data, ["spre", "--online", "."])
-    assert (code, lines) == (0, offline) and "dropped" not in err
+    assert (code, lines) == (0, [f"-:{span}" for span in offline]) and "dropped" not in err
     unchunked = mcap_file(list(follow_mcap(tmp_path / "two.mcap")), chunks=False)
     monkeypatch.setattr(sys, "stdin", SimpleNamespace(buffer=OneRecordPerRead(unchunked)))
     code = main(["spre", "--online", "."])

@@ -44,6 +44,16 @@ def test_every_printed_name_means_its_trace(given, expected):
     assert choose_trace(TABLE, given) == expected
 
 
+def test_a_hash_in_a_path_or_a_name_is_told_by_the_trace_name():
+    table = rows(("n-1", "x#y", "/d#1/f.json"), ("n-2", "y", "/d#1/g.json"))
+    assert choose_trace(table, "/d#1/f.json#x#y:2-4") == TraceChoice("n-1", (2, 4))
+    assert choose_trace(table, "/d#1/./f.json#x#y") == TraceChoice("n-1")
+    assert choose_trace(table, "/d#1/f.json#x#y") == TraceChoice("n-1")
+    assert choose_trace(table, "/d#1/../d#1/g.json#y:0-0") == TraceChoice("n-2", (0, 0))
+    with pytest.raises(UserError):
+        choose_trace(table, "/d#1/f.json#y")
+
+
 def test_a_relative_path_names_the_source(tmp_path, monkeypatch):
     (tmp_path / "t.parquet").write_bytes(b"")
     monkeypatch.chdir(tmp_path)
@@ -106,9 +116,9 @@ def _captured():
 
 def test_show_draws_the_trace_of_a_printed_match_line(printed, tmp_path, capsys):
     results, lines, _ = printed
-    place = lines[1].split()[0]  # NAME:START-END, as printed
+    place = lines[1].split()[0]  # SOURCE#NAME:START-END, as printed
     assert main(["show", str(results), "--trace", place, "-o", str(tmp_path / "m.png")]) == 0
-    name = place.rsplit(":", 1)[0]
+    name = place.rsplit(":", 1)[0].rsplit("#", 1)[1]
     assert capsys.readouterr().err.startswith(f"scenegrep: match 0 of {name} drawn in ")
 
 

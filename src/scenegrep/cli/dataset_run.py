@@ -2,7 +2,8 @@
 dataset engine either way (:func:`scenegrep.dataset.files.query_files`,
 :func:`scenegrep.dataset.run.run_query`), and one output of its results table.
 
-Output: one line per match ``NAME:START-END  correspondence`` (dataset frame indices of the
+Output: one line per match ``SOURCE#NAME:START-END  correspondence``
+(:mod:`scenegrep.dataset.places`: the source path as given, dataset frame indices of the
 window's first and last frame, inclusive), or every row of the results table with ``--json``
 (one object per row) or ``--csv``; a failed trace's error and a summary on stderr. Over files,
 each trace's rows are printed as soon as it is done. ``--output FILE`` also writes the table as
@@ -34,13 +35,14 @@ def run_query_command(
     """Run a query over ``paths`` or ``args.dataset``, print its results; returns the exit code."""
     from .. import readers
     from ..dataset import QuerySpec
+    from ..dataset.places import as_given
     from ..dataset.queries import uses_map
     from ..model.layers import UnknownLayers
 
     spec = QuerySpec.of(kind, query, origin, **options)
     if getattr(args, "map", None):
         readers.read_map(args.map)  # a bad --map is the user's error, before any trace is read
-    printer = RowPrinter(args)
+    printer = RowPrinter(args, shown=None if args.dataset else as_given(paths))
     results, where = results_of(args, spec, paths, printer)
     if args.output:
         results.write_parquet(args.output)
@@ -137,12 +139,16 @@ class RowPrinter:
     """Prints result rows as the options ask: text lines for matches (and, with ``--explain``,
     the explanation of traces without one), or every row as JSON or CSV; failed rows' errors on
     stderr; nothing with ``-q``. ``--max-count N`` prints at most N matches per trace. With
-    ``failures_only`` it prints only the failed rows' errors."""
+    ``failures_only`` it prints only the failed rows' errors. ``shown`` turns a row's recorded
+    source into the one its text lines print (default: as recorded)."""
 
-    def __init__(self, args: argparse.Namespace, failures_only: bool = False):
+    def __init__(
+        self, args: argparse.Namespace, failures_only: bool = False, shown: Callable[[str], str] | None = None
+    ):
         from ..dataset.results import csv_writer
 
         self.args = args
+        self.shown = shown
         self.failures_only = failures_only
         self.limit = getattr(args, "max_count", None)
         self.explain = getattr(args, "explain", False)
@@ -173,16 +179,27 @@ class RowPrinter:
     def _lines(self, row: dict[str, Any]) -> list[str]:
         explanation = (row["explanation"] or "").splitlines() if self.explain else []
         if row["status"] == "no match" and explanation:
-            return [f"{_place(row)}  no match: {explanation[0]}", *(f"    {line}" for line in explanation[1:])]
+            return [f"{self._place(row)}  no match: {explanation[0]}", *(f"    {line}" for line in explanation[1:])]
         if row["status"] != "match":
             return []
-        return [match_line(row), *(f"    {line}" for line in explanation)]
+        return [match_line(row, self._place(row)), *(f"    {line}" for line in explanation)]
+
+    def _place(self, row: dict[str, Any]) -> str:
+        """``SOURCE#NAME:START-END`` (:func:`scenegrep.dataset.places.place`), or
+        ``SOURCE#NAME`` for a row without frames."""
+        from ..dataset.places import place
+
+        source = row["source"] or ""
+        return place(
+            self.shown(source) if self.shown else source, row["name"], row.get("start_frame"), row.get("end_frame")
+        )
 
 
-def match_line(row: dict[str, Any]) -> str:
-    """``NAME:START-END  object=id ...  |  variable=value ...  [holds] require ...`` for a match row."""
+def match_line(row: dict[str, Any], where: str) -> str:
+    """``WHERE  object=id ...  |  variable=value ...  [holds] require ...`` for a match row
+    printed at ``where`` (its ``SOURCE#NAME:START-END``)."""
     pairs = "  ".join(f"{k}={v}" for k, v in json.loads(row["correspondence"] or "{}").items())
-    text = f"{_place(row)}  {pairs}".rstrip()
+    text = f"{where}  {pairs}".rstrip()
     values = json.loads(row.get("values") or "{}")
     variables = {k: v for k, v in values.items() if not isinstance(v, bool)}
     if variables:
@@ -191,12 +208,6 @@ def match_line(row: dict[str, Any]) -> str:
     if soft:
         text += "  |  " + "  ".join(f"[{'holds' if ok else 'fails'}] {name}" for name, ok in soft.items())
     return text
-
-
-def _place(row: dict[str, Any]) -> str:
-    """``NAME:START-END`` (dataset frame indices of the first and last frame), or ``NAME`` for a
-    row without frames."""
-    return row["name"] if row.get("start_frame") is None else f"{row['name']}:{row['start_frame']}-{row['end_frame']}"
 
 
 def _value_text(value: Any) -> str:

@@ -35,7 +35,7 @@ def add_parser(subparsers: Any) -> None:
         "--trace",
         metavar="TRACE",
         help="show this trace of the results (matched or not): its trace_id, name, source file, SOURCE#NAME, "
-        "or a match line's NAME:START-END (that match)",
+        "or a match line's SOURCE#NAME:START-END or NAME:START-END (that match)",
     )
     parser.add_argument("--frame", type=int, metavar="INDEX", help="PNG: the dataset frame index to draw")
     parser.add_argument("--dataset", metavar="DATASET", help="the dataset of the results (default: where they lie)")

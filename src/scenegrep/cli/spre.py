@@ -1,13 +1,16 @@
 """``scenegrep spre PATTERN [FILE...]``: Spatial Regular Expression matching, offline and online.
 
 Over files, the dataset engine's query (:mod:`.dataset_run`): one line per match,
-``NAME:START-END`` (dataset frame indices of the first and last frame), or the results table
-with ``--json``, ``--csv`` or ``--output``; a bad file is a failed row (exit code 3), or given
-alone a user error (exit code 2). As STREM
-does (``--compat strem``, ``--online``, ``--export``, standard input): each stream searched as it
-is read, ``PATH:START-END`` (``PATH:START..END``, STREM's first index .. last index + 1, with
-``--compat strem``; no path for standard input), and the first bad input ends the command (exit
-code 2). Exit codes: 0 some match, 1 none, 2 error, 3 some file failed.
+``SOURCE#NAME:START-END`` (:mod:`scenegrep.dataset.places`: the path as given, the trace's name,
+dataset frame indices of the first and last frame), or the results table with ``--json``,
+``--csv`` or ``--output``; a bad file is a failed row (exit code 3), or given alone a user error
+(exit code 2). As STREM does (``--compat strem``, ``--online``, ``--export``, standard input):
+each stream searched as it is read, with the same lines (``-`` the source of standard input; a
+live stream, ``--online`` over standard input or ``--follow``, has no trace name:
+``SOURCE:START-END``), or STREM's ``PATH:START..END`` (first index .. last index + 1;
+``PATH#NAME`` for a file of several traces, no path for standard input) with ``--compat
+strem``; the first bad input ends the command (exit code 2). Exit codes: 0 some match, 1 none,
+2 error, 3 some file failed.
 """
 
 from __future__ import annotations
@@ -79,8 +82,10 @@ def _export(match: Any, trace: Any, options: Any) -> dict[str, Any]:
 
 
 def _line(match: Any, source: str, prefix: str, args: argparse.Namespace, trace: Any, options: Any) -> str:
-    """One match as text (``PREFIX:START-END``), a JSON Lines record (``source``: the path as
-    given, ``-`` for standard input) or, with ``--export``, the matched frames."""
+    """One match as text (``SOURCE#NAME:START-END``, ``SOURCE:START-END`` for a live stream
+    without a ``trace``; with ``--compat strem`` STREM's ``PREFIX:START..END``), a JSON Lines
+    record (``source``: the path as given, ``-`` for standard input) or, with ``--export``, the
+    matched frames."""
     if args.json:
         record: dict[str, Any] = {
             "source": source,
@@ -96,13 +101,20 @@ def _line(match: Any, source: str, prefix: str, args: argparse.Namespace, trace:
         return line(record)
     if args.export and trace is not None:
         return json.dumps(_export(match, trace, options), separators=(",", ":"), allow_nan=True)
-    span = "{}..{}".format(*match.index_range) if args.compat == "strem" else f"{match.first_index}-{match.last_index}"
-    return f"{prefix}:{span}" if prefix else span
+    if args.compat == "strem":
+        span = "{}..{}".format(*match.index_range)
+        return f"{prefix}:{span}" if prefix else span
+    from ..dataset.places import place
+
+    if trace is None:
+        return f"{source}:{match.first_index}-{match.last_index}"
+    return place(source, trace.name, match.first_index, match.last_index)
 
 
 def _report(matches: Any, source: str, prefix: str, args: argparse.Namespace, options: Any, trace: Any = None) -> bool:
     """Print the matches of one file, ``source`` (its path as given, ``-`` for standard input),
-    each line starting with ``prefix`` (at most --max-count); True when there was any."""
+    of its ``trace`` (None for a live stream), at most --max-count, with ``--compat strem`` each
+    line starting with STREM's ``prefix``; True when there was any."""
     found = False
     printed = 0
     out = sys.stdout

@@ -4,13 +4,12 @@ name the command line prints for a trace is accepted.
 A trace is named, in the order tried, by
 
 1. its ``trace_id`` (the results' key, ``NAME-<hash>``);
-2. its ``name``, as the query commands print it (``NAME:START-END``), when one trace of the table
-   has it;
+2. its ``name``, when one trace of the table has it;
 3. its source: the ``source`` path the results record, or any path to the same file (relative to
-   the working directory), when one trace of the table came from it; or ``SOURCE#NAME`` (as
-   ``spre`` prints a trace of a file holding several);
-4. any of these followed by ``:START-END`` (a match line's place, dataset frame indices): the
-   trace and its match with that window.
+   the working directory), when one trace of the table came from it; or ``SOURCE#NAME`` (as the
+   query commands print it, :mod:`scenegrep.dataset.places`), either path form;
+4. any of these followed by ``:START-END`` (dataset frame indices): the trace and its match with
+   that window. So a match line's ``SOURCE#NAME:START-END`` selects that match.
 
 A name several traces share is an error listing them (``trace_id`` and source); an unknown name
 is an error listing the table's traces, or the nearest ones when there are more than
@@ -57,13 +56,14 @@ class _Trace:
         return names
 
     def is_file(self, given: str) -> bool:
-        """Whether ``given`` (a path, or ``PATH#NAME``) names this trace's source file."""
+        """Whether ``given`` (a path, or ``PATH#NAME``) names this trace's source file (a path or
+        a name may hold ``#``: ``PATH#NAME`` is told by its end, this trace's name)."""
         if not self.source:
             return False
-        path, _, name = given.partition("#")
-        if name and name != self.name:
-            return False
-        return _same_file(path, self.source)
+        suffix = f"#{self.name}"
+        if given.endswith(suffix) and _same_file(given[: -len(suffix)], self.source):
+            return True
+        return _same_file(given, self.source)
 
     def described(self) -> str:
         return f"{self.trace_id} ({self.source})" if self.source else self.trace_id

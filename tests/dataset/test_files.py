@@ -138,7 +138,8 @@ def test_a_bad_file_in_a_folder_fails_alone(folder, capsys):
         ["scenario", "examples/queries/s1_lane_change_stationary_car.scenic", folder, "--window", "75"], capsys
     )
     assert code == 3
-    assert [line.split(":")[0] for line in lines] == [f"fig1_lane_change-00{n}" for n in (0, 1, 3)]
+    names = [f"fig1_lane_change-00{n}" for n in (0, 1, 3)]
+    assert [line.rsplit(":", 1)[0] for line in lines] == [f"{folder}/{name}.parquet#{name}" for name in names]
     failed = [line for line in err if line.startswith("scenegrep: failed: ")]
     assert len(failed) == 2 and "fig1_lane_change-002.parquet" in failed[0] and "zz.parquet" in failed[1]
     assert "truncated or corrupt" in failed[0] and not any("Traceback" in line for line in err)
@@ -193,14 +194,16 @@ def test_one_frame_convention_in_every_output(shifted, capsys):
     base = [FIG1, shifted / "shifted.json", "--window", "3", "--map", shifted / "map.parquet", "--all"]
     out = shifted / "out.parquet"
     code, text, _ = run(["scenario", *base, "--output", out], capsys)
-    assert code == 0 and [line.split("  ")[0] for line in text] == ["table2:1-3", "table2:2-4"]
+    assert code == 0 and [line.split("  ")[0] for line in text] == [
+        f"{shifted}/shifted.json#table2:{w}" for w in ("1-3", "2-4")
+    ]
     expected = [(1, 3, 0.5, 1.5), (2, 4, 1.0, 2.0)]
     assert _spans(pq.read_table(out).to_pylist()) == expected
     assert _spans(map(json.loads, run(["scenario", *base, "--json"], capsys)[1])) == expected
     assert _spans(csv.DictReader(io.StringIO("\n".join(run(["scenario", *base, "--csv"], capsys)[1])))) == expected
     stream = REPO.parent / "shared" / "conformance" / "strem" / "data" / "noncontig.json"
     if stream.is_file():
-        assert run(["spre", "[[:car:]]{2}", stream], capsys)[1] == ["noncontig:10-20"]
+        assert run(["spre", "[[:car:]]{2}", stream], capsys)[1] == [f"{stream}#noncontig:10-20"]
         (row,) = map(json.loads, run(["spre", "--json", "[[:car:]]{2}", stream], capsys)[1])
         assert (row["start_frame"], row["end_frame"]) == (10, 20)
         assert run(["spre", "--compat", "strem", "[[:car:]]{2}", stream], capsys)[1] == [f"{stream}:10..21"]

@@ -47,7 +47,7 @@ def test_a_trace_without_a_map_takes_the_given_one_and_matches_as_with_its_own(f
         == 0
     )
     bare, _ = lines(capsys)
-    assert own and [line.replace("bare", "own", 1) for line in bare] == own
+    assert own and [line.replace("bare.json#bare", "own.json#own", 1) for line in bare] == own
     assert main(["scene", FIG3, str(folder / "bare.json"), *TOLERANCES]) == 2  # no map at all
 
 
@@ -61,7 +61,7 @@ def test_a_trace_with_its_own_map_and_a_given_one_is_an_error_for_that_trace(fol
     ]
     code = main(["scene", FIG3, str(folder / "own.json"), str(folder / "bare.json"), "--map", town, *TOLERANCES])
     out, err = lines(capsys)
-    assert code == 3 and out and all(line.startswith("bare:") for line in out)
+    assert code == 3 and out and all(line.startswith(f"{folder / 'bare.json'}#bare:") for line in out)
     assert err[0].startswith("scenegrep: failed: own: ") and "has its own road map" in err[0]
     assert main(["label", str(folder / "own.json"), "--map", town, "-o", str(folder / "labelled"), "-q"]) == 2
 

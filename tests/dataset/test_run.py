@@ -226,7 +226,8 @@ def in_process(argv: list[str], capsys) -> list[str]:
 def test_cli_outputs_and_the_catalog_agree(real_dataset: Path, tmp_path: Path, capsys):
     root = copy_of(real_dataset, tmp_path)
     lines = in_process(scenario_command(root), capsys)
-    assert len(lines) == 12 and lines[0].startswith("fig1_lane_change-000:0-74  ego=ego")
+    source = (REPO / "examples/sample/fig1_lane_change-000.parquet").resolve()  # as the catalog records it
+    assert len(lines) == 12 and lines[0].startswith(f"{source}#fig1_lane_change-000:0-74  ego=ego")
     records = [json.loads(r) for r in in_process(scenario_command(root, "--json"), capsys)]
     assert len(records) == 62 and sum(r["status"] == "match" for r in records) == 12
     output = tmp_path / "out.parquet"

@@ -36,7 +36,7 @@ def run(args, capsys):
 def test_match_line_names_window_and_correspondence(files, capsys):
     code, lines, err = run([FIG1, files / "table2.json", "--window", "5", "--map", files / "map.parquet"], capsys)
     assert code == 0
-    assert lines == ["table2:0-4  ego=car2  otherCar=car1"]
+    assert lines == [f"{files / 'table2.json'}#table2:0-4  ego=car2  otherCar=car1"]
     assert err == ["scenegrep: 1 of 1 trace matches, 0 pruned, 0 failed"]
 
 
@@ -44,7 +44,7 @@ def test_no_match_exits_1_and_explains(files, capsys):
     args = [FIG1, files / "tl.json", "--window", "5", "--map", files / "map.parquet", "--explain"]
     code, lines, _ = run(args, capsys)
     assert code == 1
-    assert lines[0].startswith("table2  no match: ") and "TurnLeft" in lines[0]
+    assert lines[0].startswith(f"{files / 'tl.json'}#table2  no match: ") and "TurnLeft" in lines[0]
 
 
 def test_json_and_explain_give_the_witness(files, capsys):

@@ -41,7 +41,7 @@ def run(args, capsys):
 def test_text_output_names_correspondence_and_values(files, capsys):
     code, lines, err = run([files / "ahead.scenic", files / "trace.json", "--map", files / "map.parquet"], capsys)
     assert code == 0 and len(lines) == 1
-    assert lines[0].startswith("hand:0-0  ego=ego  other=c  |  ")
+    assert lines[0].startswith(f"{files / 'trace.json'}#hand:0-0  ego=ego  other=c  |  ")
     assert "Range(4, 10)@3:33=6" in lines[0]  # a 6 m gap
     assert err == ["scenegrep: 1 of 1 trace matches, 0 pruned, 0 failed"]
 
@@ -66,8 +66,8 @@ def test_json_output_and_explain(files, capsys):
     ]
     assert {r["explanation"] for r in records} == {"no labeled object can be other (Car, line 3): other.x"}
     code, lines, _ = run([*args[:-1], "--explain"], capsys)  # a match, and why the other frame is none
-    assert code == 0 and lines[0].startswith("hand:0-0  ego=ego  other=c  |  ")
-    assert lines[1].startswith("hand:1-1  no match: ") and "other.x, other.y" in lines[1]
+    assert code == 0 and lines[0].startswith(f"{files / 'trace.json'}#hand:0-0  ego=ego  other=c  |  ")
+    assert lines[1].startswith(f"{files / 'trace.json'}#hand:1-1  no match: ") and "other.x, other.y" in lines[1]
 
 
 def test_exit_code_options_and_quiet(files, capsys):

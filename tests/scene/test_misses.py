@@ -130,7 +130,7 @@ def test_nuscenes_suggestion_makes_the_frame_match(real_data, capsys):
     assert "position" in options[0] and "heading" in options[2]
     assert main([*base, *options]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert any(line.startswith(f"scene-0061:{frame}-{frame}  ego=ego  otherCar={other}") for line in lines)
+    assert any(line.startswith(f"{trace}#scene-0061:{frame}-{frame}  ego=ego  otherCar={other}") for line in lines)
 
 
 @pytest.mark.real_data

@@ -20,7 +20,7 @@ def run(args, capsys):
 def test_text_json_and_export(conformance_dir, capsys):
     seq = str(conformance_dir / "strem/data/noncontig.json")
     code, lines, _ = run(["[[:car:]]{2}", seq], capsys)
-    assert (code, lines) == (0, ["noncontig:10-20"])
+    assert (code, lines) == (0, [f"{seq}#noncontig:10-20"])
     assert run(["--compat", "strem", "[[:car:]]{2}", seq], capsys)[:2] == (0, [f"{seq}:10..21"])
     code, lines, _ = run(["--json", "[[:car:]]{2}", seq], capsys)
     record = json.loads(lines[0])
@@ -34,7 +34,7 @@ def test_exit_codes_quiet_and_max_count(conformance_dir, capsys):
     seq = str(conformance_dir / "strem/data/seq_a.json")
     assert run(["[[:truck:]]", seq], capsys)[:2] == (1, [])
     assert run(["-q", "[[:car:]]", seq], capsys)[:2] == (0, [])
-    assert run(["-m", "1", "[[:car:]]", seq], capsys)[:2] == (0, ["seq_a:0-0"])
+    assert run(["-m", "1", "[[:car:]]", seq], capsys)[:2] == (0, [f"{seq}#seq_a:0-0"])
     assert run(["--compat", "strem", "-m", "1", "[[:car:]]", seq], capsys)[:2] == (0, [f"{seq}:0..1"])
     code, _, err = run(["[[:car:]", seq], capsys)
     assert code == 2 and err.startswith("scenegrep: error: <query>:1:9: ") and "^" in err
@@ -103,7 +103,7 @@ def test_online_stdin_constant_state(tmp_path):
         text=True,
         check=True,
     ).stdout.splitlines()
-    assert len(out) == 3000 and out[-1] == "0-2999"
+    assert len(out) == 3000 and out[-1] == "-:0-2999"
 
 
 @pytest.mark.parametrize(

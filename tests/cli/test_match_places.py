@@ -59,6 +59,7 @@ def printed(tmp_path_factory) -> dict[str, tuple[Path, Path | None, list[str]]]:
     return runs
 
 
+@pytest.mark.slow
 def test_every_match_line_starts_with_its_source_name_and_window(printed):
     for kind, (_, dataset, lines) in printed.items():
         assert lines, kind
@@ -73,6 +74,7 @@ def test_every_match_line_starts_with_its_source_name_and_window(printed):
             assert Path(source).stem == found["name"], line
 
 
+@pytest.mark.slow
 def test_show_takes_every_printed_place_to_that_match(printed, monkeypatch):
     monkeypatch.chdir(REPO)
     for kind, (results, dataset, lines) in printed.items():
@@ -97,6 +99,7 @@ def _each_trace_first_and_last(places: list[str]) -> list[str]:
     return [given for found in by_trace.values() for given in dict.fromkeys([found[0], found[-1]])]
 
 
+@pytest.mark.slow
 def test_spre_over_a_stream_prints_the_same_places(printed):
     """spre's stream mode (here: a file given with standard input) prints a file's matches as the
     engine's mode does, and standard input's as ``-#NAME``."""

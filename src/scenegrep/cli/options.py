@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
+from ..wording import article
 
 MAP_HELP = (
     "road map for traces without one (e.g. an .xodr or a Lanelet2 .osm file); a trace with its own map and --map "
@@ -263,8 +264,7 @@ def check_output_file(option: str, path: str, suffixes: Sequence[str]) -> str:
     suffix = Path(path).suffix.lower()
     if suffix not in suffixes:
         listed = suffixes[0] if len(suffixes) == 1 else f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
-        article = "an" if suffixes[0][1:2] in tuple("aefhilmnorsx") else "a"
-        raise UserError(f"{option} {path}: write {article} {listed} file")
+        raise UserError(f"{option} {path}: write {article(suffixes[0][1:].upper())} {listed} file")
     if Path(path).is_dir():
         raise UserError(f"{option} {path}: a directory; name the file to write")
     return suffix[1:]

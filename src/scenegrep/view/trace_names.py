@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..dataset.places import place
 from ..errors import UserError, nearest
 from ..wording import counted
 
@@ -52,7 +53,7 @@ class _Trace:
         """The names that mean this trace (see the module docstring)."""
         names = {self.trace_id, self.name}
         if self.source:
-            names |= {self.source, f"{self.source}#{self.name}"}
+            names |= {self.source, place(self.source, self.name)}
         return names
 
     def is_file(self, given: str) -> bool:

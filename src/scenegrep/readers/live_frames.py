@@ -15,7 +15,7 @@ from collections.abc import Callable, Iterable, Iterator
 
 from ..model import LabelTrace, TraceSource
 from .mcap_documents import document_frames
-from .mcap_follow import RawMessage
+from .mcap_records import RawMessage
 
 
 def live_chunks(

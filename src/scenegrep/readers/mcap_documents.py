@@ -13,7 +13,7 @@ the topic and the message's log time.
 from __future__ import annotations
 
 from ..model import LabelTrace
-from .mcap_follow import RawMessage
+from .mcap_records import RawMessage
 
 TRACE_SCHEMA = "scenegrep/Trace"
 STREM_SCHEMA = "strem/Document"

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import numpy as np
 
-from ..mcap_follow import RawMessage
+from ..mcap_records import RawMessage
 
 __all__ = ["Boxes", "DecodeError", "RawMessage", "Transforms"]
 

@@ -2,5 +2,7 @@
 
 from setuptools import Extension, setup
 
-setup(ext_modules=[Extension("scenegrep.readers._strem", ["src/scenegrep/readers/_strem.c"],
-                             extra_compile_args=["-O2", "-Wall", "-Wextra", "-Werror"])])
+FLAGS = ["-O2", "-Wall", "-Wextra", "-Werror"]
+setup(ext_modules=[Extension("scenegrep.readers._strem", ["src/scenegrep/readers/_strem.c"], extra_compile_args=FLAGS),
+                   Extension("scenegrep.readers.ros._cdr_copy", ["src/scenegrep/readers/ros/_cdr_copy.c"],
+                             extra_compile_args=FLAGS)])

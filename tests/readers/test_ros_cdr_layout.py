@@ -21,7 +21,8 @@ from mcap.writer import CompressionType, Writer
 from scenegrep import readers
 from scenegrep.errors import UserError
 from scenegrep.readers.ros.cdr import Payloads, decode
-from scenegrep.readers.ros.cdr_layout import Unsupported, _Spots, decode_same_layout, layout
+from scenegrep.readers.ros import _cdr_copy
+from scenegrep.readers.ros.cdr_layout import Unsupported, decode_same_layout, layout
 from scenegrep.readers.ros.chunks import mcap_messages
 from scenegrep.readers.ros.decoders import _DECODERS, decode_batch, type_key, types_of
 
@@ -166,12 +167,49 @@ def test_a_message_of_the_same_size_and_another_count_is_read_as_the_generic_wal
     assert per_frame.tolist() == [3] * 17 + [2] + [3] * 12
 
 
-@given(st.lists(st.integers(1, 40), max_size=30))
-def test_runs_of_evenly_spaced_places_give_back_every_place(gaps):
-    at = np.cumsum([0, *gaps]).tolist()
-    spots = _Spots.of("<f8", 1, at)
-    assert spots.columns.tolist() == [a + b for a in at for b in range(8)]
-    if spots.runs is None:
-        return
-    rebuilt = [at[start] + j * step for start, count, step in spots.runs for j in range(count)]
-    assert rebuilt == at and sum(count for _, count, _ in spots.runs) == len(at)
+def _run(origins, size, copies, row_bytes=16, out_len=64, count_at=(), base_len=64):
+    out = np.zeros(out_len, np.uint8)
+    return _cdr_copy.run(
+        np.zeros(base_len, np.uint8),
+        np.array(origins, np.int64),
+        size,
+        np.array(count_at, np.int64),
+        np.zeros(len(count_at), np.uint32),
+        np.array(copies, np.int64).reshape(-1, 4),
+        (out,),
+        np.array([row_bytes], np.int64),
+        0,
+    )
+
+
+@pytest.mark.parametrize(
+    ("origins", "size", "copies", "count_at"),
+    [
+        ([60], 8, [(0, 0, 0, 4)], ()),  # the message runs past its buffer
+        ([2], 8, [(0, 0, 0, 4)], ()),  # no room for its header
+        ([4], 8, [(6, 0, 0, 4)], ()),  # a copy past the message
+        ([4], 8, [(0, 0, 14, 4)], ()),  # a copy past its output row
+        ([4], 8, [(0, 1, 0, 4)], ()),  # an output that is not there
+        ([4] * 5, 8, [(0, 0, 0, 4)], ()),  # more rows than the output holds
+        ([4], 8, [(0, 0, 0, -1)], ()),  # a negative length
+        ([4], 8, [], (6,)),  # a count past the message
+    ],
+)
+def test_the_copy_plan_is_bounds_checked_before_it_runs(origins, size, copies, count_at):
+    with pytest.raises(ValueError):
+        _run(origins, size, copies, count_at=count_at)
+
+
+def test_the_copy_plan_stops_at_the_first_message_of_another_layout():
+    base = np.zeros(64, np.uint8)
+    base[[1, 17, 33]] = 1  # encapsulation headers 00 01 at 0, 16, 32 (origins 4, 20, 36)
+    base[20:24] = [7, 0, 0, 0]  # message 1's count
+    out = np.zeros(48, np.uint8)
+    args = (np.array([0], np.int64), np.array([7], np.uint32), np.array([[0, 0, 0, 4]], np.int64), (out,))
+    copied = _cdr_copy.run(base, np.array([4, 20, 36], np.int64), 12, *args, np.array([16], np.int64), 0)
+    assert copied == 0  # message 0's count is 0
+    base[4:8] = base[36:40] = [7, 0, 0, 0]
+    assert _cdr_copy.run(base, np.array([4, 20, 36], np.int64), 12, *args, np.array([16], np.int64), 0) == 3
+    base[33] = 0  # message 2's header
+    assert _cdr_copy.run(base, np.array([4, 20, 36], np.int64), 12, *args, np.array([16], np.int64), 0) == 2
+    assert out[:4].tolist() == out[16:20].tolist() == [7, 0, 0, 0]

@@ -6,9 +6,9 @@ sequence's length, a string's length). Two messages of one type whose sizes are 
 counts are equal at those offsets have the same layout: each offset depends only on the counts
 before it, and every bound the generic walk checks (a read past the end, a count too large for
 the bytes left) depends only on the counts and the size. :func:`decode_same_layout` checks
-exactly that for a whole batch with one gather, then reads every wanted field of every message
-as one strided view of the batch's rows (an item's field is at a constant step from the one
-before: one view, one copy), so the Python work is per field, not per message or object.
+exactly that for every message, and copies every wanted field of every message into its column,
+in one pass of C per chunk (:mod:`._cdr_copy`) over a plan made once per layout (what to
+compare, what to copy where): no Python runs per message, object or field.
 
 A batch that is not of one layout, or holds a bad header, or a type this module does not walk
 (a wanted sequence of strings or primitives) gives None: the caller decodes it with
@@ -19,12 +19,12 @@ A batch that is not of one layout, or holds a bad header, or a type this module 
 from __future__ import annotations
 
 import struct
-from operator import attrgetter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import _cdr_copy
 from .cdr import _DTYPES, HEADER, Level, Payloads, _Walker
 from .msgdef import PRIMITIVE_SIZES, STRINGS, Field
 
@@ -34,64 +34,51 @@ class Unsupported(ValueError):
     one that is malformed (the generic walk names the fault)."""
 
 
-@dataclass(frozen=True)
-class _Spots:
-    """Where one field is in every item of a level: ``k`` values of ``dtype`` at each CDR offset
-    ``at``. Items of one size are evenly spaced, items of other sizes (a longer string) break
-    that into runs: ``runs`` are (first item, items, step) of evenly spaced offsets, None when
-    there are more than :data:`MAX_RUNS` (then ``columns``, the byte offsets of all the values,
-    are gathered)."""
-
-    dtype: str
-    k: int
-    at: np.ndarray
-    runs: tuple[tuple[int, int, int], ...] | None
-    columns: np.ndarray
-
-    @classmethod
-    def of(cls, dtype: str, k: int, at: list[int]) -> _Spots:
-        spots = np.array(at, dtype=np.int64)
-        columns = (spots[:, None] + np.arange(np.dtype(dtype).itemsize * k)).ravel()
-        runs: list[tuple[int, int, int]] = []
-        start = 0
-        while start < len(spots):
-            step = int(spots[start + 1] - spots[start]) if start + 1 < len(spots) else 0
-            end = start + 1
-            while end < len(spots) and spots[end] - spots[end - 1] == step:
-                end += 1
-            runs.append((start, end - start, step))
-            start = end
-        return cls(dtype, k, spots, tuple(runs) if len(runs) <= MAX_RUNS else None, columns)
-
-
-MAX_RUNS = 8
-"""The most runs of evenly spaced places read as strided views (more are gathered)."""
-
-
 @dataclass
 class _LevelPlan:
     """One level of a layout: per item its parent item and rank; per wanted primitive field its
     dtype, values per item and each item's offset; per wanted string each item's offset and
-    length."""
+    length (its NUL included); ``blocks``: the fields read together (:func:`_blocks`)."""
 
     parent_level: str
     parent: list[int] = field(default_factory=list)
     rank: list[int] = field(default_factory=list)
     fields: dict[str, tuple[str, int, list[int]]] = field(default_factory=dict)
     strings: dict[str, tuple[list[int], list[int]]] = field(default_factory=dict)
-    blocks: list[tuple[tuple[str, ...], _Spots]] = field(default_factory=list)
+    blocks: list[tuple[tuple[str, ...], str, int, list[int]]] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _Output:
+    """One column the plan copies into: per message ``items`` x ``k`` values of ``dtype`` (a
+    string column: ``V<longest>``, zero-padded) of field(s) ``paths`` of level ``level``."""
+
+    level: str
+    paths: tuple[str, ...]
+    dtype: str
+    items: int
+    k: int
+    string: bool
+
+    @property
+    def row_bytes(self) -> int:
+        return self.items * self.k * np.dtype(self.dtype).itemsize
 
 
 @dataclass
 class Layout:
     """Where things are in a message of this layout: ``size`` its CDR bytes (after the
     encapsulation header), ``count_at`` the offsets of its counts and ``count_value`` their
-    values, ``levels`` the items and fields (offsets from the CDR origin)."""
+    values, ``levels`` the items and fields (offsets from the CDR origin); the plan run per
+    message: ``outputs`` (the columns) and ``copies`` (rows of source offset, output, offset in
+    the output's row, bytes; sorted by source offset)."""
 
     size: int
-    count_at: _Spots
+    count_at: np.ndarray
     count_value: np.ndarray
     levels: dict[str, _LevelPlan]
+    outputs: tuple[_Output, ...]
+    copies: np.ndarray
 
 
 def layout(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozenset[str], raw: bytes) -> Layout:
@@ -160,11 +147,30 @@ def layout(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozense
     walk(type_name, "", "", 0, 0)
     for plan in levels.values():
         plan.blocks = _blocks(plan.fields)
-    at = _Spots.of("<u4", 1, [c[0] for c in counts])
-    return Layout(len(raw), at, np.array([c[1] for c in counts], dtype=np.uint32), levels)
+    outputs, copies = _program(levels)
+    at = np.array([c[0] for c in counts], dtype=np.int64)
+    return Layout(len(raw), at, np.array([c[1] for c in counts], dtype=np.uint32), levels, outputs, copies)
 
 
-def _blocks(fields: dict[str, tuple[str, int, list[int]]]) -> list[tuple[tuple[str, ...], _Spots]]:
+def _program(levels: dict[str, _LevelPlan]) -> tuple[tuple[_Output, ...], np.ndarray]:
+    """The columns of a layout and the copies that fill them from one message: every item's
+    block of fields is one copy, every string's bytes one (after its count, NUL included)."""
+    outputs: list[_Output] = []
+    copies: list[tuple[int, int, int, int]] = []
+    for name, plan in levels.items():
+        for paths, dtype, k, at in plan.blocks:
+            size = np.dtype(dtype).itemsize * k
+            copies.extend((a, len(outputs), j * size, size) for j, a in enumerate(at))
+            outputs.append(_Output(name, paths, dtype, len(at), k, False))
+        for path, (at, lengths) in plan.strings.items():
+            longest = max(max(lengths, default=0), 1)
+            copies.extend((a, len(outputs), j * longest, n) for j, (a, n) in enumerate(zip(at, lengths)) if n)
+            outputs.append(_Output(name, (path,), f"V{longest}", len(at), 1, True))
+    program = np.array(sorted(copies), dtype=np.int64).reshape(len(copies), 4)
+    return tuple(outputs), program
+
+
+def _blocks(fields: dict[str, tuple[str, int, list[int]]]) -> list[tuple[tuple[str, ...], str, int, list[int]]]:
     """The wanted fields of a level as blocks read at once: single values of one type that
     follow each other without a gap in every item (a point's x, y, z) are one block of k values;
     any other field is a block of its own."""
@@ -179,7 +185,7 @@ def _blocks(fields: dict[str, tuple[str, int, list[int]]]) -> list[tuple[tuple[s
             if other != dtype or count != 1 or any(b != a + size * len(paths) for a, b in zip(at, places)):
                 break
             paths.append(order[i + len(paths)][0])
-        blocks.append((tuple(paths), _Spots.of(dtype, len(paths) if k == 1 else k, at)))
+        blocks.append((tuple(paths), dtype, len(paths) if k == 1 else k, at))
         i += len(paths)
     return blocks
 
@@ -187,125 +193,70 @@ def _blocks(fields: dict[str, tuple[str, int, list[int]]]) -> list[tuple[tuple[s
 @dataclass(frozen=True)
 class _Group:
     """Messages of a batch that lie in one buffer (one decompressed chunk): ``base`` its bytes,
-    ``origins`` each message's CDR origin in it (after its header), ``stride`` the constant step
-    between them (0 for one message), None when they are not evenly spaced."""
+    ``origins`` each message's CDR origin in it (after its encapsulation header)."""
 
     base: np.ndarray
     origins: np.ndarray
-    stride: int | None
 
 
-def _group(base: np.ndarray, origins: np.ndarray) -> _Group:
-    steps = np.diff(origins)
-    stride = 0 if not len(steps) else int(steps[0]) if (steps == steps[0]).all() and steps[0] > 0 else None
-    return _Group(base, origins, stride)
-
-
-def _address(buffer) -> int:
-    """The memory address of a buffer's first byte."""
-    return np.frombuffer(buffer, np.uint8).__array_interface__["data"][0]
-
-
-def _groups(payloads: Sequence) -> list[_Group] | None:
-    """The batch as runs of messages sharing one buffer (memoryviews of one chunk; bytes are
-    copied into one buffer), or None when the payloads' sizes differ or one lacks the
-    little-endian CDR encapsulation header."""
-    size = len(payloads[0])
-    if size < HEADER or set(map(len, payloads)) != {size}:
+def _groups(payloads: Sequence) -> tuple[int, list[_Group]] | None:
+    """The batch's payload size and its runs of messages sharing one buffer (memoryviews of one
+    chunk; bytes are copied into one buffer), or None when the payloads' sizes differ or are
+    shorter than the encapsulation header."""
+    n = len(payloads)
+    address, size, owner = (np.empty(n, np.int64) for _ in range(3))
+    _cdr_copy.addresses(payloads, address, size, owner)
+    if size[0] < HEADER or (size != size[0]).any():
         return None
     if set(map(type, payloads)) != {memoryview}:
         base = np.frombuffer(b"".join(payloads), dtype=np.uint8)
-        groups = [_group(base, np.arange(len(payloads), dtype=np.int64) * size + HEADER)]
-    else:
-        owners = list(map(attrgetter("obj"), payloads))
-        same = np.fromiter(map(id, owners), np.int64, len(owners))  # (all alive: ids are distinct)
-        cuts = [0, *(np.flatnonzero(same[1:] != same[:-1]) + 1).tolist(), len(owners)]
-        address = np.fromiter(map(_address, payloads), np.int64, len(payloads))
-        groups = []
-        for start, end in zip(cuts, cuts[1:]):
-            base = np.frombuffer(owners[start], dtype=np.uint8)
-            groups.append(_group(base, address[start:end] - _address(base) + HEADER))
-    for g in groups:
-        if (g.base[g.origins - HEADER] != 0).any() or (g.base[g.origins - HEADER + 1] != 1).any():
-            return None
-    return groups
+        return int(size[0]), [_Group(base, np.arange(n, dtype=np.int64) * int(size[0]) + HEADER)]
+    cuts = [0, *(np.flatnonzero(owner[1:] != owner[:-1]) + 1).tolist(), n]
+    groups = []
+    for start, end in zip(cuts, cuts[1:]):
+        base = np.frombuffer(payloads[start].obj, dtype=np.uint8)
+        groups.append(_Group(base, address[start:end] - base.__array_interface__["data"][0] + HEADER))
+    return int(size[0]), groups
 
 
-def _values(group: _Group, spots: _Spots, out: np.ndarray) -> np.ndarray:
-    """Per message of ``group``, the field at ``spots``, written into ``out`` (shape (messages,
-    spots, k)) and returned: one strided view of the group's buffer per run of evenly spaced
-    places (:class:`_Spots`) when the group's messages are evenly spaced, else one gather."""
-    n, m = len(group.origins), len(spots.at)
-    if group.stride is not None and spots.runs is not None:
-        size, first = np.dtype(spots.dtype).itemsize, int(group.origins[0])
-        for start, count, step in spots.runs:
-            at = first + int(spots.at[start])
-            view = np.ndarray((n, count, spots.k), spots.dtype, group.base, at, (group.stride, step, size))
-            out[:, start : start + count] = view
-        return out
-    out[...] = group.base[group.origins[:, None] + spots.columns].view(spots.dtype).reshape(n, m, spots.k)
-    return out
+def _texts(raw: np.ndarray) -> np.ndarray:
+    """Strings of zero-padded bytes (``V<n>``), decoded once per distinct value (trailing NULs
+    dropped, as the generic walk decodes each)."""
+    unique, inverse = np.unique(raw, return_inverse=True)
+    decoded = np.array([bytes(u).rstrip(b"\0").decode("utf-8", "replace") for u in unique], dtype=object)
+    return decoded[inverse.ravel()]
 
 
-def matches(plan: Layout, groups: list[_Group]) -> bool:
-    """Whether every message of ``groups`` (all of the plan's size) has the layout ``plan``."""
-    if not len(plan.count_at.at):
-        return True
-    counts = plan.count_at
-    return all(
-        (_values(g, counts, np.empty((len(g.origins), len(counts.at), 1), "<u4"))[:, :, 0] == plan.count_value).all()
-        for g in groups
-    )
-
-
-def _strings(groups: list[_Group], at: list[int], lengths: list[int]) -> np.ndarray:
-    """Per message, the string at each offset (of its length): item order (message, then
-    offset); decoded once per distinct value, as the generic walk decodes each."""
-    n, m = sum(len(g.origins) for g in groups), len(at)
-    texts = np.empty(n * m, dtype=object)
-    for j, (pos, length) in enumerate(zip(at, lengths)):
-        if not length:
-            texts[j::m] = ""
-            continue
-        spots = _Spots.of(f"V{length}", 1, [pos])
-        raw = np.concatenate([_values(g, spots, np.empty((len(g.origins), 1, 1), spots.dtype)).ravel() for g in groups])
-        unique, inverse = np.unique(raw, return_inverse=True)
-        decoded = np.array([bytes(u).rstrip(b"\0").decode("utf-8", "replace") for u in unique], dtype=object)
-        texts[j::m] = decoded[inverse.ravel()]
-    return texts
-
-
-def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level]:
-    """The levels of the messages of ``groups`` (every one of layout ``plan``: check
-    :func:`matches` first), in message order. Every block of fields of a group is copied out
-    before the next group is read (its chunk is then still in cache)."""
+def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level] | None:
+    """The levels of the messages of ``groups`` (all of the plan's size) in message order, or
+    None when one of them is not of layout ``plan`` (another count, or a bad header)."""
     n = sum(len(g.origins) for g in groups)
-    wanted = [(name, paths, spots) for name, p in plan.levels.items() for paths, spots in p.blocks]
-    columns = {(name, paths): np.empty((n, len(s.at), s.k), s.dtype) for name, paths, s in wanted}
+    columns = tuple((np.zeros if o.string else np.empty)((n, o.items, o.k), o.dtype) for o in plan.outputs)
+    row_bytes = np.array([o.row_bytes for o in plan.outputs], dtype=np.int64)
     start = 0
     for g in groups:
-        end = start + len(g.origins)
-        for name, paths, spots in wanted:
-            _values(g, spots, columns[name, paths][start:end])
-        start = end
-    sizes = {name: len(p.parent) for name, p in plan.levels.items()}
+        copied = _cdr_copy.run(
+            g.base, g.origins, plan.size, plan.count_at, plan.count_value, plan.copies, columns, row_bytes, start
+        )
+        if copied < len(g.origins):
+            return None
+        start += len(g.origins)
     out: dict[str, Level] = {}
     for name, p in plan.levels.items():
         m = len(p.parent)
         message = np.repeat(np.arange(n, dtype=np.int64), m)
         parent = message
         if name:
-            parent = message * sizes[p.parent_level] + np.tile(np.array(p.parent, dtype=np.int64), n)
-        fields: dict[str, np.ndarray] = {}
-        for paths, spots in p.blocks:
-            values = columns[name, paths]
-            if len(paths) == 1:
-                fields[paths[0]] = values.reshape(n * m) if spots.k == 1 else values.reshape(n * m, spots.k)
-            else:
-                fields.update((path, values[:, :, j].reshape(n * m)) for j, path in enumerate(paths))
-        for path, (at, lengths) in p.strings.items():
-            fields[path] = _strings(groups, at, lengths)
-        out[name] = Level(parent, np.tile(np.array(p.rank, dtype=np.int64), n), fields)
+            parent = message * len(plan.levels[p.parent_level].parent) + np.tile(np.array(p.parent, dtype=np.int64), n)
+        out[name] = Level(parent, np.tile(np.array(p.rank, dtype=np.int64), n), {})
+    for o, values in zip(plan.outputs, columns):
+        fields = out[o.level].fields
+        if o.string:
+            fields[o.paths[0]] = _texts(values.reshape(n * o.items))
+        elif len(o.paths) == 1:
+            fields[o.paths[0]] = values.reshape(n * o.items) if o.k == 1 else values.reshape(n * o.items, o.k)
+        else:
+            fields.update((path, values[:, :, j].reshape(n * o.items)) for j, path in enumerate(o.paths))
     return out
 
 
@@ -320,16 +271,16 @@ def decode_same_layout(
     """The levels of a batch of one layout (that of ``cache[key]``, else of its first message,
     then kept there), or None when the batch is not of one layout (see the module docstring).
     ``payloads``: each message's bytes or a memoryview into its chunk (read in place)."""
-    groups = _groups(payloads)
-    if groups is None:
+    found = _groups(payloads)
+    if found is None:
         return None
+    size, groups = found
     plan = cache.get(key)
-    if plan is None or plan.size != len(payloads[0]) - HEADER or not matches(plan, groups):
+    levels = decode_groups(plan, groups) if plan is not None and plan.size == size - HEADER else None
+    if levels is None:
         try:
-            plan = layout(types, type_name, wanted, bytes(payloads[0][HEADER:]))
+            plan = cache[key] = layout(types, type_name, wanted, bytes(payloads[0][HEADER:]))
         except Unsupported:
             return None
-        cache[key] = plan
-        if not matches(plan, groups):
-            return None
-    return decode_groups(plan, groups)
+        levels = decode_groups(plan, groups)
+    return levels

@@ -37,7 +37,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("scene",),  # Scenic scene queries (on the Scenic front end, maps through the readers)
     ("scenario", "synth"),  # scenario queries and Scenic-generated data, both on scene queries
     ("dataset",),  # the engine over many traces: ingest, catalog, queries, exports
-    ("view", ""),  # pictures and pages of results; "" is scenegrep/__init__ (scenegrep.open_dataset)
+    ("view", "streams", ""),  # pictures and pages of results; queries over streams as read; "" is scenegrep/__init__
     ("cli",),  # the command line: thin faces over all of the above
     ("__main__",),  # python -m scenegrep
 )

@@ -25,7 +25,7 @@ import pytest
 from mcap.writer import CompressionType, Writer
 
 from scenegrep import readers
-from scenegrep.cli.live import Latency
+from scenegrep.streams.latency import Latency
 from scenegrep.cli.main import main
 from scenegrep.readers.mcap_documents import STREM_SCHEMA, TRACE_SCHEMA
 from scenegrep.readers.mcap_follow import MAGIC, RawMessage, follow_mcap

@@ -83,11 +83,11 @@ def run(args: argparse.Namespace) -> int:
 def _refav(args: argparse.Namespace) -> int:
     from ..dataset.refav_export import check_request, refav_sequences
     from ..dataset.refav_format import sequence_counts, write_sequences
-    from ..view.sources import ResultsSource
+    from ..dataset.results_traces import ResultsTraces
 
     check_request(args.refav, args.prompt)
-    source = ResultsSource.open(args.results, args.dataset)
-    sequences = refav_sequences(source.results, lambda trace_id: source.load(trace_id)[0], args.prompt, args.referred)
+    source = ResultsTraces.open(args.results, args.dataset)
+    sequences = refav_sequences(source.results, source.trace, args.prompt, args.referred)
     write_sequences(sequences, args.refav)
     if not args.quiet:
         logs, positive, frames = sequence_counts(sequences)
@@ -105,15 +105,15 @@ def _moments(args: argparse.Namespace, option: str, folder: str) -> Iterator[Any
     checked (UserError for an empty name or a file), the results opened, what they leave unknown
     said on stderr (failed traces, an interrupted run: no moments there), and the moments."""
     from ..dataset.moments import check_output_folder, left_out, moments
-    from ..view.sources import ResultsSource
+    from ..dataset.results_traces import ResultsTraces
 
     if args.prompt is not None or args.referred is not None:
         raise UserError("--prompt and --referred go with --refav")
     check_output_folder(folder, option)
-    source = ResultsSource.open(args.results, args.dataset)
+    source = ResultsTraces.open(args.results, args.dataset)
     for sentence in [] if args.quiet else left_out(source.results, args.results):
         print(f"scenegrep: {sentence}", file=sys.stderr)
-    return moments(source.results, lambda trace_id: source.load(trace_id)[0], args.context)
+    return moments(source.results, source.trace, args.context)
 
 
 def _openscenario(args: argparse.Namespace) -> int:

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections.abc import Iterator
 from typing import Any
 
 from .dataset_run import RowPrinter, run_query_command
@@ -96,14 +95,13 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_online(args: argparse.Namespace) -> int:
     """``--online``: trace documents or MCAP messages from stdin, or ``--follow FILE``; each match
-    printed as its window completes."""
+    printed as its window completes; the program objects no frame could be are said at the end."""
     from .. import readers
-    from ..dataset.queries import scenario_rows
     from ..errors import UserError
-    from ..label.online import OnlineLabeller
     from ..scenario import ScenarioOptions, load_scenario, load_vocabulary
-    from ..scenario.online import OnlineScenario, final_results, online_results
-    from .live import report, until_stopped
+    from ..streams.live import trace_documents
+    from ..streams.scenario import ScenarioStream
+    from .live import open_input, report, until_stopped
 
     if args.data or args.dataset:
         raise UserError("--online reads stdin or --follow FILE; give no DATA or --dataset")
@@ -112,44 +110,26 @@ def _run_online(args: argparse.Namespace) -> int:
     road_map = readers.read_map(args.map) if args.map else None
     choice = unknown_layers_of(args)
     options = ScenarioOptions(tolerance_of(args), args.visible_distance, args.all, unknown_layers=choice)
-    matcher = OnlineScenario(query, args.window, road_map, options)
-    labeller = OnlineLabeller(road_map, unknown_layers=choice)
+    live = open_input(args, trace_documents)
+    stream = ScenarioStream(query, args.window, road_map, options, live.source, args.all, args.explain)
     printer = RowPrinter(args)
-    source = args.follow or "-"
-    chunks, latency = _chunks(args)
 
     def announce(delay: str) -> None:
         if not args.quiet:
             print(f"scenegrep: {delay}", file=sys.stderr)
 
     def show(results: list[Any]) -> None:
-        for result in latency.each_match(results):
-            identity = {"trace_id": result.trace.name, "name": result.trace.name, "source": source}
-            printer([{**identity, **row} for row in scenario_rows(result, args.all, args.explain)])
+        for result in live.latency.each_match(results):
+            printer(stream.rows(result))
 
     with until_stopped():
-        for results in online_results(chunks, matcher, labeller, announce):
+        for results in stream.results(live.chunks, announce):
             show(results)
-    show(final_results(matcher, labeller))
-    for warning in labeller.warnings:
-        print(f"scenegrep: {warning}", file=sys.stderr)
+    show(stream.final())
+    for warning in [] if args.quiet else stream.warnings:
+        print(f"scenegrep: warning: {warning}", file=sys.stderr)
+    for note in stream.notes:
+        print(f"scenegrep: {note}", file=sys.stderr)
     report_unknown_layers(choice)
-    report(latency, args)
-    return 0 if latency.found else EXIT_NO_MATCH
-
-
-def _chunks(args: argparse.Namespace) -> tuple[Iterator[Any], Any]:
-    """The frames of the live input (MCAP) or of the JSON trace documents on stdin, and their latency."""
-    import time
-
-    from ..readers.trace_json import decode
-    from .live import Latency, mcap_chunks, standard_input
-
-    if args.follow:
-        return mcap_chunks(args.follow, args)
-    is_mcap, stdin = standard_input()
-    if is_mcap:
-        return mcap_chunks("-", args, stdin)
-    latency = Latency(time.perf_counter, args.latency)
-    lines = ((number, line) for number, line in enumerate(stdin, start=1) if line.strip())
-    return latency.chunks(decode(line, f"<stdin>:{number}", "stdin") for number, line in lines), latency
+    report(live.latency, args)
+    return 0 if live.latency.found else EXIT_NO_MATCH

@@ -16,11 +16,10 @@ strem``; the first bad input ends the command (exit code 2). Exit codes: 0 some 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
+from collections.abc import Iterable
 from typing import Any
 
-from ..json_lines import line
 from .dataset_run import run_query_command
 from .exit_codes import EXIT_NO_MATCH
 from .options import (
@@ -70,51 +69,13 @@ def add_parser(subparsers: Any) -> None:
     parser.set_defaults(run=run)
 
 
-def _export(match: Any, trace: Any, options: Any) -> dict[str, Any]:
-    """The matched frames: a STREM JSON document for image detections, else a scenegrep JSON trace."""
-    if trace.images is not None and options.space != "topdown":
-        from ..writers.strem_json import strem_document
-
-        return strem_document(trace, match.start, match.end, options.channels)
-    from ..writers.trace_json import trace_document
-
-    return trace_document(trace.slice_frames(match.start, match.end))
-
-
-def _line(match: Any, source: str, prefix: str, args: argparse.Namespace, trace: Any, options: Any) -> str:
-    """One match as text (``SOURCE#NAME:START-END``, ``SOURCE:START-END`` for a live stream
-    without a ``trace``; with ``--compat strem`` STREM's ``PREFIX:START..END``), a JSON Lines
-    record (``source``: the path as given, ``-`` for standard input) or, with ``--export``, the
-    matched frames."""
-    if args.json:
-        record: dict[str, Any] = {
-            "source": source,
-            "start_frame": match.first_index,
-            "end_frame": match.last_index,
-            "start_time": match.start_time,
-            "end_time": match.end_time,
-        }
-        if trace is not None:
-            record["trace"] = trace.name
-        if match.bound:
-            record["bound"] = match.bound
-        return line(record)
-    if args.export and trace is not None:
-        return json.dumps(_export(match, trace, options), separators=(",", ":"), allow_nan=True)
-    if args.compat == "strem":
-        span = "{}..{}".format(*match.index_range)
-        return f"{prefix}:{span}" if prefix else span
-    from ..dataset.places import place
-
-    if trace is None:
-        return f"{source}:{match.first_index}-{match.last_index}"
-    return place(source, trace.name, match.first_index, match.last_index)
-
-
-def _report(matches: Any, source: str, prefix: str, args: argparse.Namespace, options: Any, trace: Any = None) -> bool:
-    """Print the matches of one file, ``source`` (its path as given, ``-`` for standard input),
-    of its ``trace`` (None for a live stream), at most --max-count, with ``--compat strem`` each
-    line starting with STREM's ``prefix``; True when there was any."""
+def _report(
+    matches: Iterable[Any], source: str, prefix: str, args: argparse.Namespace, form: Any, trace: Any = None
+) -> bool:
+    """Print the matches of one input, ``source`` (its path as given, ``-`` for standard input),
+    of its ``trace`` (None for a live stream), as ``form`` writes them
+    (:class:`~scenegrep.streams.spre.MatchFormat`), at most --max-count (online, the rest are still
+    read), with ``--compat strem`` each line starting with STREM's ``prefix``; True when there was any."""
     found = False
     printed = 0
     out = sys.stdout
@@ -124,11 +85,17 @@ def _report(matches: Any, source: str, prefix: str, args: argparse.Namespace, op
             if not args.online:
                 break
             continue
-        out.write(_line(match, source, prefix, args, trace, options) + "\n")
+        out.write(form.text(match, source, prefix, trace) + "\n")
         printed += 1
         if args.online:
             out.flush()
     return found
+
+
+def _warn(warnings: Iterable[str], args: argparse.Namespace) -> None:
+    """Each warning on stderr, unless ``-q``."""
+    for warning in [] if args.quiet else warnings:
+        print(f"scenegrep: warning: {warning}", file=sys.stderr)
 
 
 def _streams(args: argparse.Namespace) -> bool:
@@ -163,50 +130,37 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_streams(args: argparse.Namespace) -> int:
-    from .. import readers
-    from ..spre import SearchOptions, TraceSearch, compile_query
+    from ..spre import SearchOptions, compile_query
+    from ..streams.spre import MatchFormat, input_searches
 
     query = compile_query(args.pattern, compat=args.compat == "strem")
     for warning in query.warnings:
         print(f"scenegrep: warning: {warning}", file=sys.stderr)
     options = SearchOptions(args.space, tuple(args.channel) if args.channel else None, max(args.skip, 0))
+    form = MatchFormat(args.json, args.export, args.compat == "strem", options)
     if args.follow:
-        return _run_live(query, args, options)
+        return _run_live(query, args, options, form)
     found = False
     for path in args.files or ["-"]:
         if path == "-" and args.online:
-            found |= _run_live(query, args, options) == 0
+            found |= _run_live(query, args, options, form) == 0
             continue
-        many = path != "-" and readers.FORMATS[readers.detect_format(path)].many
-        for trace in readers.read_traces(path):
-            bound = TraceSearch(query, trace, options)
-            for warning in [] if args.quiet else bound.warnings:
-                print(f"scenegrep: warning: {path if path != '-' else '<stdin>'}: {warning}", file=sys.stderr)
-            matches = bound.online() if args.online else bound.offline()
-            prefix = "" if path == "-" else f"{path}#{trace.name}" if many else path
-            found |= _report(matches, path, prefix, args, options, bound.trace)
+        for search in input_searches(query, path, options, args.online):
+            _warn(search.warnings, args)
+            found |= _report(search.matches, path, search.prefix, args, form, search.trace)
     return 0 if found else EXIT_NO_MATCH
 
 
-def _run_live(query: Any, args: argparse.Namespace, options: Any) -> int:
-    """Online matching of a live input: ``--follow FILE``, or standard input (MCAP or STREM JSON)."""
-    import time
-
+def _run_live(query: Any, args: argparse.Namespace, options: Any, form: Any) -> int:
+    """Online matching of a live input: ``--follow FILE``, or standard input (MCAP or STREM JSON);
+    the names the query uses that the stream lacked are said when it has ended."""
     from ..readers.strem_json import iter_documents
-    from ..spre import search_stream
-    from .live import Latency, mcap_chunks, report, standard_input, until_stopped
+    from ..streams.spre import LiveSearch
+    from .live import open_input, report, until_stopped
 
-    if args.follow:
-        chunks, latency = mcap_chunks(args.follow, args)
-    else:
-        is_mcap, stdin = standard_input()
-        if is_mcap:
-            chunks, latency = mcap_chunks("-", args, stdin)
-        else:
-            latency = Latency(time.perf_counter, args.latency)
-            chunks = latency.chunks(iter_documents(stdin))
+    search = LiveSearch(query, open_input(args, iter_documents), options)
     with until_stopped():
-        source = args.follow or "-"
-        _report(latency.each_match(search_stream(query, chunks, options)), source, args.follow or "", args, options)
-    report(latency, args)
-    return 0 if latency.found else EXIT_NO_MATCH
+        _report(search.matches, search.live.source, search.prefix, args, form)
+    _warn(search.warnings, args)
+    report(search.live.latency, args)
+    return 0 if search.live.latency.found else EXIT_NO_MATCH

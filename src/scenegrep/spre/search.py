@@ -36,6 +36,7 @@ from .parser import parse
 from .space import Space, image_space, topdown_space
 from .strem_parser import parse_strem
 from .tokens import MAX_CHARACTERS
+from .vocabulary import SeenNames
 
 
 @dataclass(frozen=True)
@@ -174,18 +175,9 @@ class TraceSearch:
         """One line per class name of the query and image channel of the options that this trace
         lacks (:mod:`scenegrep.spre.vocabulary`; classes of all its channels): names that can never
         hold here."""
-        from ..model.taxonomy import kind_of
-        from .vocabulary import unknown_channels, unknown_classes
-
-        images = self.trace.images
-        if self.evaluator.space.kind == "image" and images is not None:
-            present = {images.boxes.classes[code] for code in np.unique(images.boxes.category)}
-        else:
-            present = set(self.trace.objects.category.astype(str).tolist())
-        found = unknown_classes(self.query.tree, self.query.compat, [(c, kind_of(c)) for c in present])
-        if self.options.channels and images is not None:
-            found += unknown_channels(self.options.channels, images.samples.channels)
-        return found
+        seen = SeenNames()
+        seen.add(self.trace, self.evaluator.space.kind)
+        return seen.warnings(self.query.tree, self.query.compat, self.options.channels)
 
     def matches(self, spans: Iterable[tuple[int, int]]) -> Iterator[Match]:
         """Matches of the given (start, end) position pairs."""
@@ -230,11 +222,16 @@ def search(
 
 
 def search_stream(
-    query: CompiledQuery, chunks: Iterable[LabelTrace], options: SearchOptions = SearchOptions()
+    query: CompiledQuery,
+    chunks: Iterable[LabelTrace],
+    options: SearchOptions = SearchOptions(),
+    seen: SeenNames | None = None,
 ) -> Iterator[Match]:
     """Online matching over a stream that arrives as consecutive traces (e.g. STREM documents on
     stdin): each frame is matched as soon as its chunk arrives, in memory independent of the
-    stream's length. Track binders need whole traces and are rejected here."""
+    stream's length. Track binders need whole traces and are rejected here. ``seen`` (if given)
+    gathers the names of the frames searched (skipped frames not), for the warnings of the names
+    the query uses that the stream lacks (:meth:`SeenNames.warnings`, once the stream ended)."""
     if query.has_track_binders:
         raise UserError("track binders E(...)(...) need the whole trace; they cannot run on a live stream")
     if query.compat:
@@ -248,7 +245,10 @@ def search_stream(
             dropped = min(skip, chunk.n_frames)
             skip -= dropped
             chunk = chunk.slice_frames(dropped, chunk.n_frames)
-        evaluator = Evaluator(build_space(chunk, options, query.compat), strem=query.compat)
+        space = build_space(chunk, options, query.compat)
+        if seen is not None and chunk.n_frames:
+            seen.add(chunk, space.kind)
+        evaluator = Evaluator(space, strem=query.compat)
         frames = list(
             zip(range(position, position + chunk.n_frames), chunk.frame_index.tolist(), chunk.frame_time.tolist())
         )

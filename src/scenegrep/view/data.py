@@ -12,25 +12,17 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from ..dataset.results_traces import QueryInfo
 from ..errors import UserError
 from ..model import LabelTrace, RoadMap
 
 MAP_MARGIN = 25.0
 """Metres of road map kept around the area the trace's objects cover."""
-
-
-@dataclass(frozen=True)
-class QueryInfo:
-    """The query behind a results table: its kind ('scenario', 'scene', 'spre'), text and options."""
-
-    kind: str
-    text: str
-    options: Mapping[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -33,13 +33,14 @@ from ..dataset import Dataset
 from ..dataset.catalog import within
 from ..dataset.queries import OPTIONS, QuerySpec
 from ..dataset.results import RESULTS_FILE, Results
+from ..dataset.traces import load_trace
 from ..errors import UserError
 from .data import build_view
 from .guard import TIME_LIMIT, TOKEN_HEADER, Refused, check_host, check_post, check_token, dataset_file, public_message
 from .limited import QueryTimeout, run_limited, start_fork_server, stop_all
 from .page import asset, html_page, view_page
 from .report import report_page
-from .sources import ResultsSource, load_trace
+from .sources import ResultsSource
 
 HOST = "127.0.0.1"
 READ_TIMEOUT = 10.0

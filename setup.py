@@ -4,5 +4,7 @@ from setuptools import Extension, setup
 
 FLAGS = ["-O2", "-Wall", "-Wextra", "-Werror"]
 setup(ext_modules=[Extension("scenegrep.readers._strem", ["src/scenegrep/readers/_strem.c"], extra_compile_args=FLAGS),
+                   Extension("scenegrep.readers._mcap_index", ["src/scenegrep/readers/_mcap_index.c"],
+                             extra_compile_args=FLAGS),
                    Extension("scenegrep.readers.ros._cdr_copy", ["src/scenegrep/readers/ros/_cdr_copy.c"],
                              extra_compile_args=FLAGS)])

@@ -186,3 +186,18 @@ def test_flipped_bytes_are_messages_or_a_one_line_error(good, flips):
             assert isinstance(m.data, memoryview)
     except UserError as error:
         assert "\n" not in error.one_line()
+
+
+def test_a_message_in_a_chunk_on_an_undeclared_channel_is_an_error_after_the_messages_before_it():
+    data = _write(ITEMS, CompressionType.NONE, 10_000, True)  # one chunk
+    seventh = struct.pack("<HIQQ", 1, 0, 6_000, 6_000)  # the 7th message: channel 1 (topic /t0), log time 6000
+    at = data.index(seventh)
+    bad = data[:at] + struct.pack("<H", 9) + data[at + 2 :]
+    line = _one_line(bad)
+    assert "after topic /t2, message at log time 5000 ns: Chunk record at byte" in line
+    # the chunk's records: after its header (start, end, size u64, crc u32), compression "" and their length
+    records = _chunks(bad)[0] + 9 + 28 + 4 + 8
+    inner = at - 9 - records  # the Message record's byte offset among the chunk's records
+    assert line.endswith(
+        f"in its records, Message record at byte {inner}: log time 6000 ns: channel 9 was never declared"
+    )

@@ -10,7 +10,7 @@ data to the body's end), Chunk 0x06 (start, end u64, uncompressed size u64, crc 
 compression string, records u64-prefixed: uncompressed, ``lz4`` or ``zstd``; the records
 inside are framed like the top-level ones). Strings are a uint32 length and UTF-8 bytes; other
 records are skipped; CRCs are not checked. Schema id 0 is "no schema" (name, encoding, data
-empty).
+empty). A chunk's messages are made by one C loop (:mod:`._mcap_index`), not a Python step each.
 
 Bounds: every length is checked against its body before it is used; a record or a chunk's
 uncompressed size over the reader's ``limit`` is refused before it is read or decompressed
@@ -24,6 +24,8 @@ from __future__ import annotations
 import struct
 from collections.abc import Iterator
 from typing import NamedTuple
+
+from . import _mcap_index
 
 MAGIC = b"\x89MCAP0\r\n"
 HEADER = struct.Struct("<BQ")
@@ -182,24 +184,25 @@ class Records:
         self.channels[channel_id] = (topic, *schema, encoding)
 
     def _chunk(self, offset: int, body: memoryview) -> Iterator[RawMessage]:
+        """The messages of a Chunk record: runs of them made by one C loop (:mod:`._mcap_index`),
+        which stops at each definition (read here) and at a bad message (named here)."""
         data = memoryview(self._records(offset, body))
-        at, end = 0, len(data)
-        unpack = HEADER.unpack_from
-        while at < end:
-            if at + HEADER.size > end or at + HEADER.size + unpack(data, at)[1] > end:
-                raise McapFormatError(
-                    describe(offset, CHUNK, f"a record inside runs past the end of its chunk at byte {at}")
-                )
-            opcode, length = unpack(data, at)
-            start = at + HEADER.size
-            if opcode in (MESSAGE, SCHEMA, CHANNEL):
-                try:
-                    message = self._record(at, opcode, data[start : start + length])
-                except McapFormatError as exc:
-                    raise McapFormatError(describe(offset, CHUNK, f"in its records, {exc}")) from None
-                if message is not None:
-                    yield message
-            at = start + length
+        at = 0
+        while True:
+            try:
+                found, at, opcode = _mcap_index.messages(data, at, self.channels, RawMessage, self.views)
+            except ValueError as exc:
+                reason, where = exc.args
+                raise McapFormatError(describe(offset, CHUNK, f"{reason} at byte {where}")) from None
+            yield from found
+            if opcode < 0:
+                return
+            length = HEADER.unpack_from(data, at)[1]
+            try:
+                self._record(at, opcode, data[at + HEADER.size : at + HEADER.size + length])
+            except McapFormatError as exc:
+                raise McapFormatError(describe(offset, CHUNK, f"in its records, {exc}")) from None
+            at += HEADER.size + length
 
     def _records(self, offset: int, body: memoryview) -> bytes:
         """A Chunk record's records, decompressed (its uncompressed size checked first)."""

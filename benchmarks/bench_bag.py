@@ -16,7 +16,7 @@ a subprocess, with a pattern that every frame matches, so every frame prints one
 * ``--source strem``: one STREM JSON document of ``--boxes`` image boxes per frame (a
   ``strem/Document`` channel), pattern ``[[:car:]]+``;
 * ``--source ros``: Autoware ``TrackedObjects`` + ``/tf`` of the AV2 log 7fab2350 (``../shared``),
-  written by the tests' writer (tests/readers/ros_writer.py), ``--frames`` at most 156, pattern
+  written by :mod:`scenegrep.writers.ros_bag`, ``--frames`` at most 156, pattern
   ``[[:car:]]`` over top-down boxes.
 
 Per frame:
@@ -95,11 +95,9 @@ def strem_frames(frames: int, boxes: int) -> list[list[RawMessage]]:
 
 
 def ros_frames(frames: int) -> list[list[RawMessage]]:
-    """Each frame's messages as the tests' writer writes the AV2 log: /tf and TrackedObjects."""
-    sys.path.insert(0, str(REPO / "tests" / "readers"))
-    from ros_writer import write_tracked
-
+    """Each frame's messages as scenegrep.writers.ros_bag writes the AV2 log: /tf and TrackedObjects."""
     from scenegrep import readers
+    from scenegrep.writers.ros_bag import write_tracked
 
     trace = readers.read_trace(REPO.parent / "shared" / "real_data" / AV2).slice_frames(0, frames)
     grouped: list[list] = []
@@ -190,7 +188,8 @@ def read_throughput(messages: int, objects: int, runs: int) -> dict:
 
     from scenegrep.readers.ros.bag import bag_messages
     from scenegrep.readers.ros.reader import read_trace
-    from tests.readers.ros_writer import Box, ORIGIN_NS, schema, tracked_object
+    from scenegrep.writers.ros_bag import ORIGIN_NS
+    from scenegrep.writers.ros_messages import Box, schema, tracked_object
 
     def encoder(name: str):
         full = name.replace("/", "/msg/")

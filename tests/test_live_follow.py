@@ -33,7 +33,7 @@ from scenegrep.writers.trace_json import trace_document, write_trace_json
 from scenegrep.writers.trace_parquet import write_map_parquet
 
 from .live_writer import has_open
-from .readers.ros_writer import TRACKED_TOPIC, write_detections2d, write_tracked
+from scenegrep.writers.ros_bag import TRACKED_TOPIC, write_detections2d, write_tracked
 from .scenario.worked_example import worked_map, worked_trace
 
 FIG1 = "examples/queries/fig1_lane_change.scenic"
@@ -175,7 +175,7 @@ def test_spre_follow_prints_each_match_within_100ms_of_its_last_frame(files):
 
 @pytest.fixture(scope="module")
 def ros_run(real_data, files) -> SimpleNamespace:
-    """TrackedObjects + /tf of 20 frames of an AV2 log written live (tests/readers/ros_writer.py)
+    """TrackedObjects + /tf of 20 frames of an AV2 log written live (scenegrep.writers.ros_bag)
     while ``spre --space topdown --online '[[:pedestrian:]]' --follow`` reads them: the run, the
     frames with a pedestrian (from the raw states) and each frame's last message."""
     trace = readers.read_trace(real_data / AV2).slice_frames(0, 20)
@@ -279,7 +279,7 @@ def test_latency_line_gives_median_and_p99_in_milliseconds():
 
 @pytest.mark.parametrize("pattern", ["[[:car:]]+", "[[:car:]][[:pedestrian:]]", "[[:pedestrian:]]"])
 def test_detection2d_messages_on_stdin_give_the_stream_answers(conformance_dir, tmp_path, monkeypatch, capsys, pattern):
-    """A STREM stream written as vision_msgs/Detection2DArray (tests/readers/ros_writer.py), piped in:
+    """A STREM stream written as vision_msgs/Detection2DArray (scenegrep.writers.ros_bag), piped in:
     the matches ``spre --online`` finds on the STREM file itself."""
     stream = conformance_dir / "strem/data/seq_a.json"
     write_detections2d(readers.read_trace(stream), tmp_path / "boxes.mcap")

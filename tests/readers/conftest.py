@@ -9,7 +9,7 @@ import pytest
 from scenegrep import readers
 from scenegrep.model import LabelTrace
 
-from .ros_writer import ORIGIN_NS, write_tracked
+from scenegrep.writers.ros_bag import ORIGIN_NS, write_tracked
 
 AV2_LOG = "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
 

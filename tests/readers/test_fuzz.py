@@ -141,9 +141,9 @@ def _write_map_parquet(folder: Path) -> None:
 
 def _write_lanelet2(folder: Path) -> None:
     """The seed of the lanelet2 case: the AV2 sensor log's map written as a Lanelet2 map."""
-    from tests.readers.lanelet2_writer import write_lanelet2
+    from scenegrep.writers.lanelet2 import write_av2_lanelet2
 
-    write_lanelet2(json.loads((SENSOR / SENSOR_MAP).read_bytes()), folder / "map.osm")
+    write_av2_lanelet2(json.loads((SENSOR / SENSOR_MAP).read_bytes()), folder / "map.osm")
 
 
 SEEDS = {

@@ -1,5 +1,5 @@
 """Lanelet2 ``.osm`` maps: a hand-made map for each tagging rule, malformed maps as one-line errors,
-and the AV2 log 7fab2350's map written as Lanelet2 (tests.readers.lanelet2_writer) read back equal
+and the AV2 log 7fab2350's map written as Lanelet2 (scenegrep.writers.lanelet2) read back equal
 to the AV2 reader's map, with the same query answers on the log."""
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from scenegrep.model import LaneNeighbour
 from scenegrep.readers import lanelet2
 from scenegrep.writers import write_map_parquet, write_trace_parquet
 from tests.conftest import REPO
-from tests.readers.lanelet2_writer import write_lanelet2
+from scenegrep.writers.lanelet2 import write_av2_lanelet2
 
 LOG = "av2/sensor/7fab2350-7eaf-3b7e-a39d-6937a4c1bede"
 
@@ -257,7 +257,7 @@ def av2(real_data, tmp_path_factory):
     log = real_data / LOG
     map_path = next((log / "map").glob("log_map_archive_*.json"))
     document = orjson.loads(map_path.read_bytes())
-    osm_path = write_lanelet2(document, folder / "7fab2350.osm")
+    osm_path = write_av2_lanelet2(document, folder / "7fab2350.osm")
     trace = readers.read_trace(log)
     bare = write_trace_parquet(dataclasses.replace(trace, map_source=None), folder / "7fab2350.parquet")
     return {

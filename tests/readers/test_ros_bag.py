@@ -20,8 +20,11 @@ from scenegrep.readers.ros.framing import FrameBuilder
 from scenegrep.readers.ros.options import BagOptions
 from scenegrep.readers.ros.reader import read_trace
 
-from .ros_writer import TRACKED_TOPIC as TOPIC
-from .ros_writer import ORIGIN_NS, BagWriter, frame_stamps, read_back_id, write_scene_updates, write_tracked
+from scenegrep.writers.foxglove import write_scene_updates
+from scenegrep.writers.ros_bag import TRACKED_TOPIC as TOPIC
+from scenegrep.writers.ros_bag import ORIGIN_NS, BagWriter, frame_stamps, write_tracked
+
+from .ros_writer import read_back_id, write_faulty
 
 NUSCENES = "nuscenes_mini_scenarionet/sd_nuscenes_v1.0-mini_scene-0061.pkl"
 ORIGIN = ORIGIN_NS
@@ -143,7 +146,7 @@ def test_a_bag_directory_reads_as_its_mcap_file(av2, tmp_path):
 
 def test_fed_one_message_at_a_time_each_chunk_is_one_frame_and_all_is_the_offline_trace(short):
     trace, folder = short
-    write_tracked(trace, folder / "late.mcap", ORIGIN, late_tf=True)  # each /tf after its frame's objects
+    write_faulty(trace, folder / "late.mcap", ORIGIN, late_tf=True)  # each /tf after its frame's objects
     builder = FrameBuilder(BagOptions(), "late", TraceSource(str(folder / "late.mcap"), "ros-bag"))
     chunks = []
     for message in bag_messages(folder / "late.mcap"):
@@ -160,7 +163,7 @@ def test_fed_one_message_at_a_time_each_chunk_is_one_frame_and_all_is_the_offlin
 
 def test_dropped_messages_leave_out_their_frames(short):
     trace, folder = short
-    write_tracked(trace, folder / "drop.mcap", ORIGIN, drop=frozenset({0, 7, 8}))
+    write_faulty(trace, folder / "drop.mcap", ORIGIN, drop=frozenset({0, 7, 8}))
     assert_same(trace, readers.read_trace(folder / "drop.mcap"), np.setdiff1d(np.arange(25), [0, 7, 8]))
 
 

@@ -14,7 +14,7 @@ from mcap_ros2._dynamic import serialize_dynamic
 from scenegrep.readers.ros.decoders import AUTOWARE_LABELS, decode_batch
 from scenegrep.readers.ros.messages import RawMessage
 
-from .ros_writer import COVARIANCE, ZERO, schema
+from scenegrep.writers.ros_messages import COVARIANCE, ZERO, schema
 
 NAME = "autoware_perception_msgs/TrackedObjects"
 ENCODE = serialize_dynamic(NAME.replace("/", "/msg/"), schema(NAME))[NAME.replace("/", "/msg/")]

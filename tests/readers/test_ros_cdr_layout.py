@@ -26,7 +26,7 @@ from scenegrep.readers.ros.cdr_layout import Unsupported, decode_same_layout, la
 from scenegrep.readers.ros.chunks import mcap_messages
 from scenegrep.readers.ros.decoders import _DECODERS, decode_batch, type_key, types_of
 
-from .ros_writer import schema
+from scenegrep.writers.ros_messages import schema
 from .test_ros_cdr import NAME, _message, obj
 
 KEY = type_key(NAME)

@@ -12,7 +12,7 @@ from scenegrep.cli.main import main
 from scenegrep.readers.ros.options import BagOptions
 from scenegrep.readers.ros.reader import read_trace
 
-from .ros_writer import write_detections2d
+from scenegrep.writers.ros_bag import write_detections2d
 
 STREAMS = ["channels.json", "seq_b.json"]
 

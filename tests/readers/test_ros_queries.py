@@ -1,12 +1,12 @@
 """Every query kind returns on a bag what it returns on the trace the bag was written from.
 
 The AV2 log 7fab2350 is written as TrackedObjects, vision_msgs Detection3DArray or Foxglove
-SceneUpdate cubes, with /tf (:mod:`.ros_writer`); the trace compared is the log as those
-messages can carry it: classes as Autoware labels (TrackedObjects), no velocity (the others),
-no ego velocity (``/tf`` carries none), the bag's attributes. ``/tf`` carries no ego size either:
-the bag is queried with ``--ego-size`` (the log's own ego size); without it, a query that needs
-the ego's extent is an error naming the option. Both are queried through the command line with
-the log's own map, and their match rows must be equal.
+SceneUpdate cubes, with /tf (:mod:`scenegrep.writers.ros_bag`, :mod:`scenegrep.writers.foxglove`);
+the trace compared is the log as those messages can carry it: classes as Autoware labels
+(TrackedObjects), no velocity (the others), no ego velocity (``/tf`` carries none), the bag's
+attributes. ``/tf`` carries no ego size either: the bag is queried with ``--ego-size`` (the log's
+own ego size); without it, a query that needs the ego's extent is an error naming the option. Both
+are queried through the command line with the log's own map, and their match rows must be equal.
 """
 
 from __future__ import annotations
@@ -24,7 +24,11 @@ from scenegrep.readers.ros.options import BagOptions
 from scenegrep.readers.ros.reader import read_trace as read_bag
 from scenegrep.writers.trace_parquet import write_trace_parquet
 
-from .ros_writer import KIND_LABEL, ORIGIN_NS, read_back_id, write_scene_updates, write_tracked
+from scenegrep.writers.foxglove import write_scene_updates
+from scenegrep.writers.ros_bag import ORIGIN_NS, write_tracked
+from scenegrep.writers.ros_messages import KIND_LABEL
+
+from .ros_writer import read_back_id
 
 LABELS = ("UNKNOWN", "CAR", "TRUCK", "BUS", "TRAILER", "MOTORCYCLE", "BICYCLE", "PEDESTRIAN", "ANIMAL", "HAZARD")
 REAL = "examples/queries/real"

@@ -31,7 +31,7 @@ def polygon_between(left: np.ndarray, right: np.ndarray) -> BaseGeometry:
     return shapely.make_valid(shapely.Polygon(np.vstack([left[:, :2], right[::-1, :2]])))
 
 
-def _normals(centreline: np.ndarray) -> np.ndarray:
+def left_normals(centreline: np.ndarray) -> np.ndarray:
     """Unit vectors pointing left of the direction of travel at each centreline point."""
     tangent = np.gradient(centreline, axis=0) if len(centreline) > 1 else np.array([[0.0, 1.0]])
     norm = np.linalg.norm(tangent, axis=1, keepdims=True)
@@ -45,7 +45,7 @@ def lane_polygon(centreline: np.ndarray, left_width: ArrayLike, right_width: Arr
     centre = np.asarray(centreline, dtype=np.float64)[:, :2]
     left = np.broadcast_to(np.asarray(left_width, dtype=np.float64), len(centre))[:, None]
     right = np.broadcast_to(np.asarray(right_width, dtype=np.float64), len(centre))[:, None]
-    normals = _normals(centre)
+    normals = left_normals(centre)
     ring = np.vstack([centre + normals * left, (centre - normals * right)[::-1]])
     return shapely.make_valid(shapely.Polygon(ring))
 

@@ -41,11 +41,7 @@ README = REPO / "README.md"
 EXCLUDED = {
     "python3 -m venv .venv && .venv/bin/pip install": "installs packages from the network into a new venv "
     "(tests/test_readme.py runs the first quick-start command's scenegrep part)",
-    "scenegrep scene --unknown-layers strict prog.scenic autoware_log.parquet": "no Autoware log or Lanelet2 map "
-    "ships or is in ../shared (tests/readers/test_lanelet2.py builds maps)",
     "duckdb ": "the DuckDB shell is not a dependency (fleet.sql in the Python example below reads the catalog)",
-    "scenegrep info drive.mcap": "no ROS 2 bag ships or is in ../shared (tests/readers/ros_writer.py makes them)",
-    "scenegrep scene examples/scenes/fig3_car_ahead.scenic drive.mcap": "no ROS 2 bag ships or is in ../shared",
 }
 """Commands (by how they start) that this test does not run, and why."""
 

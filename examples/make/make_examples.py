@@ -13,7 +13,12 @@
   seed 0): the car ahead (class ``car``) and a pedestrian walking ahead (``pedestrian``);
 - ``examples/stream.mcap`` and ``examples/trace.mcap``: the same as MCAP files, one JSON document
   per frame and message (schemas ``strem/Document`` and ``scenegrep/Trace``, topics ``/camera``
-  and ``/trace``, frames 0.1 s apart), what ``--follow`` reads while a recorder writes it.
+  and ``/trace``, frames 0.1 s apart), what ``--follow`` reads while a recorder writes it;
+- ``examples/drive.mcap``: the whole sample trace ``fig1_lane_change-000`` (15 s at 10 Hz) as an
+  Autoware stack logs it (:mod:`scenegrep.writers.ros_bag`): ``TrackedObjects`` in the ego's
+  frame ``base_link`` and the ego's pose in the map frame on ``/tf``, stamped from 2023-11-14;
+- ``examples/lanelet2_map.osm``: ``examples/map.parquet``'s map (which holds the whole trace) as a
+  Lanelet2 map, Autoware style (:mod:`scenegrep.writers.lanelet2`): lanes, shoulders and curbs.
 
 Run from the repository root: ``python examples/make/make_examples.py`` (Scenic is needed for
 the last two). The same Scenic version and seeds give the same files.
@@ -32,6 +37,8 @@ from scenegrep import readers
 from scenegrep.model import LabelTrace
 from scenegrep.synth.scenic_scenes import sample_scenes
 from scenegrep.synth.simulate import simulate_runs
+from scenegrep.writers.lanelet2 import write_road_map_lanelet2
+from scenegrep.writers.ros_bag import write_tracked
 from scenegrep.writers.trace_json import trace_document
 from scenegrep.writers.trace_parquet import write_map_parquet
 
@@ -108,6 +115,14 @@ def write_stream() -> None:
     (EXAMPLES / "stream.json").write_text(text + "\n")
 
 
+def write_drive(out: Path = EXAMPLES) -> None:
+    """``drive.mcap`` (a sample trace as an Autoware bag) and ``lanelet2_map.osm`` (``map.parquet``
+    as Lanelet2) in ``out``."""
+    trace = readers.read_trace(EXAMPLES / "sample" / "fig1_lane_change-000.parquet")
+    write_tracked(trace, out / "drive.mcap")
+    write_road_map_lanelet2(readers.read_map(EXAMPLES / "map.parquet"), out / "lanelet2_map.osm")
+
+
 def write_mcap(path: Path, topic: str, schema: str, documents: list[dict]) -> None:
     """``documents`` as the JSON messages of one MCAP channel, 0.1 s apart."""
     from mcap.writer import Writer
@@ -139,3 +154,4 @@ if __name__ == "__main__":
         write_scenes()
         write_stream()
     write_mcaps()
+    write_drive()

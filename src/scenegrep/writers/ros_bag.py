@@ -7,8 +7,9 @@ ego's frame ``base_link``, and the ego's pose in the map frame ``map`` on ``/tf`
 ``vision_msgs/Detection2DArray``. Messages are dicts of :mod:`.ros_messages` encoded to CDR by
 mcap-ros2-support's writer (independent of scenegrep's decoder), schemas as rosbag2 writes them.
 Frame ``f`` is stamped ``origin_ns`` plus its time, and its messages are logged 20 ms later.
-What :mod:`scenegrep.readers.ros` reads back is the trace (objects, kinds, map-frame poses, sizes,
-velocities, times), ids through :func:`.ros_messages.object_uuid` for Autoware messages.
+What :mod:`scenegrep.readers.ros` reads back is the trace: objects, kinds, map-frame poses, sizes
+and velocities, times; Autoware ids through :func:`.ros_messages.object_uuid`; the ego's size never
+(``/tf`` and odometry carry none) and its velocity only from odometry.
 """
 
 from __future__ import annotations

@@ -213,3 +213,35 @@ def test_the_copy_plan_stops_at_the_first_message_of_another_layout():
     base[33] = 0  # message 2's header
     assert _cdr_copy.run(base, np.array([4, 20, 36], np.int64), 12, *args, np.array([16], np.int64), 0) == 2
     assert out[:4].tolist() == out[16:20].tolist() == [7, 0, 0, 0]
+
+
+def test_uuids_that_share_a_sort_key_are_still_told_apart():
+    from scenegrep.readers.ros.decoders import _uuid_text
+
+    mix = 0x9E3779B97F4A7C15  # the key mixes the two words: (mix, 0) and (0, 1) share one
+    words = np.array([[mix, 0], [0, 1], [mix, 0], [5, 5]], dtype="<u8")
+    raw = words.view(np.uint8).reshape(4, 16)
+    texts = _uuid_text(raw)
+    expected = [bytes(r).hex() for r in raw]
+    assert [t.replace("-", "") for t in texts] == expected and texts[0] is texts[2]
+
+
+@given(
+    st.lists(st.lists(st.sampled_from([0.0, 0.5, 1.0, -np.inf, np.nan]), max_size=3), min_size=1, max_size=6),
+    st.booleans(),
+)
+def test_the_best_row_per_item_is_the_highest_score_first_of_equal_ones(scores, shuffle):
+    from scenegrep.readers.ros.cdr import Level
+    from scenegrep.readers.ros.decoders import _best
+
+    rows = [(item, rank, s) for item, row in enumerate(scores) for rank, s in enumerate(row)]
+    if shuffle:
+        rows = rows[1:] + rows[:1]
+    parent = np.array([r[0] for r in rows], dtype=np.int64)
+    level = Level(parent, np.array([r[1] for r in rows], dtype=np.int64), {"p": np.array([r[2] for r in rows])})
+    expected = []
+    for item in range(len(scores)):
+        mine = [(i, r, s) for i, (p, r, s) in enumerate(rows) if p == item]
+        ranked = sorted(mine, key=lambda t: (np.isnan(t[2]), -t[2] if not np.isnan(t[2]) else 0, t[1]))
+        expected.append(ranked[0][0] if ranked else -1)
+    assert _best(level, "p", len(scores)).tolist() == expected

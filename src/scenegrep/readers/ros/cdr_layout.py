@@ -256,7 +256,8 @@ def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level] | None
         elif len(o.paths) == 1:
             fields[o.paths[0]] = values.reshape(n * o.items) if o.k == 1 else values.reshape(n * o.items, o.k)
         else:
-            fields.update((path, values[:, :, j].reshape(n * o.items)) for j, path in enumerate(o.paths))
+            block = values.reshape(n * o.items, o.k)
+            fields.update((path, block[:, j]) for j, path in enumerate(o.paths))  # strided views, no copy
     return out
 
 

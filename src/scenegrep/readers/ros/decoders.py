@@ -76,28 +76,45 @@ def _frames(names: np.ndarray) -> np.ndarray:
     return out
 
 
-def _ordered(level: Level) -> np.ndarray:
-    """The rows of a level in message order (by parent, then position in the sequence); no sort
-    when they are in that order already (a batch of one layout is decoded in it)."""
+def _ordered(level: Level) -> np.ndarray | slice:
+    """The rows of a level in message order (by parent, then position in the sequence): all of
+    them as they are (a slice, no copy) when they are in that order already (a batch of one
+    layout is decoded in it), else a sort."""
     parent, rank = np.diff(level.parent), np.diff(level.rank)
     if ((parent > 0) | ((parent == 0) & (rank > 0))).all():
-        return np.arange(len(level.parent))
+        return slice(None)
     return np.lexsort((level.rank, level.parent))
 
 
-def _vector(fields: dict[str, np.ndarray], prefix: str, names: Sequence[str], rows: np.ndarray) -> np.ndarray:
-    return np.stack([fields[prefix + n].astype(np.float64)[rows] for n in names], axis=1)
+def _vector(fields: dict[str, np.ndarray], prefix: str, names: Sequence[str], rows: np.ndarray | slice) -> np.ndarray:
+    """The fields ``prefix + name`` of ``rows`` as the float64 columns of one (n, len(names)) array."""
+    columns = [fields[prefix + n][rows] for n in names]
+    out = np.empty((len(columns[0]), len(names)))
+    for j, column in enumerate(columns):
+        out[:, j] = column
+    return out
 
 
 def _best(level: Level | None, score: str, n_items: int) -> np.ndarray:
     """Per parent item (0..n_items-1), the row of ``level`` with the highest ``score`` (the first
-    of equal ones), -1 for a parent without rows."""
+    of equal ones; NaN lowest), -1 for a parent without rows. Rows in message order with as many
+    per item (one layout) and no NaN: one argmax, else one sort."""
     best = np.full(n_items, -1, dtype=np.int64)
-    if level is not None and len(level.parent):
-        order = np.lexsort((level.rank, -level.fields[score].astype(np.float64), level.parent))
-        parent = level.parent[order]
-        first = np.r_[True, parent[1:] != parent[:-1]]
-        best[parent[first]] = order[first]
+    if level is None or not len(level.parent):
+        return best
+    values = level.fields[score].astype(np.float64)
+    per = len(values) // n_items
+    if (
+        per * n_items == len(values)
+        and (level.parent == np.repeat(np.arange(n_items), per)).all()
+        and (level.rank == np.tile(np.arange(per), n_items)).all()
+        and not np.isnan(values).any()
+    ):
+        return np.argmax(values.reshape(n_items, per), axis=1) + np.arange(n_items) * per
+    order = np.lexsort((level.rank, -values, level.parent))
+    parent = level.parent[order]
+    first = np.r_[True, parent[1:] != parent[:-1]]
+    best[parent[first]] = order[first]
     return best
 
 
@@ -124,9 +141,16 @@ def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:
 def _uuid_text(raw: np.ndarray) -> np.ndarray:
     """Canonical UUID strings of (n, 16) bytes (formatted once per distinct UUID)."""
     words = np.ascontiguousarray(raw, dtype=np.uint8).view("<u8").reshape(len(raw), 2)
-    order = np.lexsort((words[:, 1], words[:, 0]))
+    # sorted by one key per UUID (a mix of its two words), or by both words when two UUIDs share a key
+    key = words[:, 0] ^ (words[:, 1] * np.uint64(0x9E3779B97F4A7C15))
+    order = np.argsort(key)
     ordered = words[order]
-    new = np.r_[True, (ordered[1:] != ordered[:-1]).any(axis=1)] if len(raw) else np.zeros(0, bool)
+    differ = (ordered[1:] != ordered[:-1]).any(axis=1)
+    if (differ & (key[order][1:] == key[order][:-1])).any():
+        order = np.lexsort((words[:, 1], words[:, 0]))
+        ordered = words[order]
+        differ = (ordered[1:] != ordered[:-1]).any(axis=1)
+    new = np.r_[True, differ] if len(raw) else np.zeros(0, bool)
     inverse = np.empty(len(raw), dtype=np.int64)
     inverse[order] = np.cumsum(new) - 1
     texts = []
@@ -204,7 +228,7 @@ def _vision3d() -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:
         row_frame = np.where(own_frame != "", own_frame, frames[message])
         results = levels.get("detections.results")
         best = _best(results, "hypothesis.score", len(found.parent))[rows]
-        category = np.full(len(rows), "unknown", dtype=object)
+        category = np.full(len(found.parent), "unknown", dtype=object)
         if (best >= 0).any():  # (a level of no rows has no fields)
             category[best >= 0] = results.fields["hypothesis.class_id"][best[best >= 0]]
         given = f["id"][rows]
@@ -220,7 +244,7 @@ def _vision3d() -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:
             _vector(f, "bbox.center.position.", _XYZ, rows),
             _vector(f, "bbox.center.orientation.", "xyzw", rows),
             _vector(f, "bbox.size.", _XYZ, rows),
-            np.full((len(rows), 3), np.nan),
+            np.full((len(found.parent), 3), np.nan),
             stamps,
         )
 
@@ -246,8 +270,8 @@ def _vision2d(topic: str) -> tuple[frozenset[str], Callable[[dict[str, Level]], 
         position = "bbox.center.position." if "bbox.center.position.x" in f else "bbox.center."
         results = levels.get("detections.results")
         best = _best(results, "hypothesis.score", len(found.parent))[rows]
-        category = np.full(len(rows), "unknown", dtype=object)
-        score = np.full(len(rows), np.nan)
+        category = np.full(len(found.parent), "unknown", dtype=object)
+        score = np.full(len(found.parent), np.nan)
         if (best >= 0).any():  # (a level of no rows has no fields)
             category[best >= 0] = results.fields["hypothesis.class_id"][best[best >= 0]]
             score[best >= 0] = results.fields["hypothesis.score"][best[best >= 0]]

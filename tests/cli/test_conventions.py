@@ -49,7 +49,8 @@ MISSPELT = {
 }
 """An option of each command misspelt, and the option meant."""
 
-OUTPUT = {"coverage": "output", "ingest": "into", "label": "output", "report": "output", "scenario": "output"}
+OUTPUT = {"coverage": "output", "export": "output", "ingest": "into", "label": "output", "report": "output"}
+OUTPUT |= {"scenario": "output"}
 OUTPUT |= {"scene": "output", "show": "output", "spre": "output", "synth": "output"}
 """The commands that write a file or folder named by ``-o``, and the option ``-o`` stands for."""
 
@@ -141,6 +142,7 @@ def test_dash_o_is_the_output(command, parser):
     assert ("-o" in actions) == (command in OUTPUT)
     if command in OUTPUT:
         assert actions["-o"].dest == OUTPUT[command]
+        assert actions["--output"] is actions["-o"]  # -o/--output everywhere (ingest also --into)
 
 
 def test_spre_online_has_no_short_form(parser, capsys):

@@ -1,5 +1,10 @@
-"""``scenegrep export RESULTS (--mcap OUT.mcap | --refav OUT --prompt TEXT | --openscenario DIR |
---scenic DIR)``: a results table for other tools.
+"""``scenegrep export RESULTS -o OUT [--format mcap|refav|openscenario|scenic]``: a results table for
+other tools.
+
+``-o/--output OUT`` names what is written, as in every command; the kind is ``--format``'s, else
+OUT's suffix says it (``.mcap``: MCAP events; ``.pkl``, ``.json``: a RefAV submission); a folder
+needs ``--format`` (``openscenario`` or ``scenic``). ``--mcap OUT``, ``--refav OUT``,
+``--openscenario DIR`` and ``--scenic DIR`` are the same as ``-o`` with that format.
 
 RESULTS is a results table (Parquet, JSON lines or CSV) or a run directory. ``--mcap`` writes
 its matches as Foxglove events; ``--refav`` writes a RefAV scenario-mining submission
@@ -15,6 +20,7 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 from ..errors import UserError
@@ -33,12 +39,24 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("results", metavar="RESULTS", help="a results table (.parquet/.json/.csv) or a run directory")
     target = parser.add_mutually_exclusive_group(required=True)
+    target.add_argument(
+        "-o",
+        "--output",
+        metavar="OUT",
+        help="the file or folder to write, of --format's kind (default: by OUT's suffix, .mcap or .pkl/.json)",
+    )
     target.add_argument("--mcap", metavar="OUT", help="the MCAP file to write")
     target.add_argument("--refav", metavar="OUT", help="the RefAV submission to write: OUT.pkl (RefAV's) or OUT.json")
     target.add_argument(
         "--openscenario", metavar="DIR", help="the folder to write each match to as OpenSCENARIO (.xosc)"
     )
     target.add_argument("--scenic", metavar="DIR", help="the folder to write each match to as a Scenic program")
+    parser.add_argument(
+        "--format",
+        choices=FORMATS,
+        help="with -o: what to write (mcap: Foxglove events; refav: a RefAV submission; openscenario, scenic: a "
+        "folder of one file per match)",
+    )
     parser.add_argument(
         "--context",
         metavar="R",
@@ -60,7 +78,32 @@ def add_parser(subparsers: Any) -> None:
     parser.set_defaults(run=run)
 
 
+FORMATS = ("mcap", "refav", "openscenario", "scenic")
+"""What ``export`` writes; each is also an option naming its output (``--mcap OUT``)."""
+
+SUFFIXES = {".mcap": "mcap", ".pkl": "refav", ".json": "refav"}
+"""The kind an output file's suffix says, when ``--format`` does not."""
+
+
+def output_kind(output: str, kind: str | None) -> str:
+    """What ``-o OUT`` writes: ``kind`` (``--format``), else the kind ``output``'s suffix says
+    (any case); UserError when neither says."""
+    if kind is not None:
+        return kind
+    found = SUFFIXES.get(Path(output).suffix.lower())
+    if found is None:
+        raise UserError(
+            f"-o {output}: say what to write with --format {'|'.join(FORMATS)} (a .mcap file is MCAP events, a .pkl "
+            "or .json file a RefAV submission)"
+        )
+    return found
+
+
 def run(args: argparse.Namespace) -> int:
+    if args.format is not None and args.output is None:
+        raise UserError(f"--format goes with -o/--output (or write --{args.format} OUT)")
+    if args.output is not None:
+        setattr(args, output_kind(args.output, args.format), args.output)
     if args.context is not None and args.openscenario is None and args.scenic is None:
         raise UserError("--context goes with --openscenario or --scenic")
     if args.scenic is not None:
@@ -85,6 +128,8 @@ def _refav(args: argparse.Namespace) -> int:
     from ..dataset.refav_format import sequence_counts, write_sequences
     from ..dataset.results_traces import ResultsTraces
 
+    if args.output is not None and not args.prompt:
+        raise UserError(f"-o {args.output}: a RefAV submission needs --prompt TEXT: RefAV keys it by (log id, prompt)")
     check_request(args.refav, args.prompt)
     source = ResultsTraces.open(args.results, args.dataset)
     sequences = refav_sequences(source.results, source.trace, args.prompt, args.referred)
@@ -98,6 +143,11 @@ def _refav(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     return 0
+
+
+def _option(args: argparse.Namespace, option: str) -> str:
+    """How the user named the output: ``-o``, or the format's own ``option``."""
+    return "-o" if args.output is not None else option
 
 
 def _moments(args: argparse.Namespace, option: str, folder: str) -> Iterator[Any]:
@@ -119,7 +169,7 @@ def _moments(args: argparse.Namespace, option: str, folder: str) -> Iterator[Any
 def _openscenario(args: argparse.Namespace) -> int:
     from ..dataset.openscenario_export import write_openscenario
 
-    summary = write_openscenario(_moments(args, "--openscenario", args.openscenario), args.openscenario)
+    summary = write_openscenario(_moments(args, _option(args, "--openscenario"), args.openscenario), args.openscenario)
     if not args.quiet:
         print(
             f"scenegrep: {counted(len(summary.files), 'match')} written as OpenSCENARIO 1.3 to {args.openscenario}",
@@ -152,7 +202,7 @@ def _openscenario(args: argparse.Namespace) -> int:
 def _scenic(args: argparse.Namespace) -> int:
     from ..dataset.scenic_export import without_map_counts, write_scenic_programs
 
-    written = write_scenic_programs(_moments(args, "--scenic", args.scenic), args.scenic)
+    written = write_scenic_programs(_moments(args, _option(args, "--scenic"), args.scenic), args.scenic)
     if not args.quiet:
         for reason, count in without_map_counts(written).items():
             print(

@@ -30,7 +30,13 @@ def add_parser(subparsers: Any) -> None:
     )
     parser.add_argument("sources", nargs="+", metavar="SOURCE", help="inputs or directories of inputs")
     parser.add_argument(
-        "-o", "--into", required=True, metavar="DATASET", help="the dataset directory (created if needed)"
+        "-o",
+        "--output",
+        "--into",
+        dest="into",
+        required=True,
+        metavar="DATASET",
+        help="the dataset directory (created if needed)",
     )
     add_jobs_argument(parser)
     parser.add_argument("--no-label", action="store_true", help="do not label traces without behaviour labels")

@@ -8,7 +8,9 @@ furthest frame reached and what failed there. ``--json``, ``--csv`` and ``--outp
 results table (:mod:`.dataset_run`). Traces without behaviour labels are labelled first with
 their own road map, as ``ingest`` labels them. ``--online`` reads scenegrep JSON trace documents
 (one per line) or an MCAP stream from stdin, ``--follow FILE`` an MCAP file as it is written
-(:mod:`.live`), and reports each match as soon as its window is complete. Exit codes:
+(:mod:`.live`), and reports each match as soon as its window is complete
+(:class:`scenegrep.streams.scenario.ScenarioStream`); the program objects whose kinds no frame had
+are warned about once the stream has ended. Exit codes:
 0 some trace matches, 1 none, 2 error, 3 some trace failed.
 """
 

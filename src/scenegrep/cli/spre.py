@@ -9,8 +9,9 @@ each stream searched as it is read, with the same lines (``-`` the source of sta
 live stream, ``--online`` over standard input or ``--follow``, has no trace name:
 ``SOURCE:START-END``), or STREM's ``PATH:START..END`` (first index .. last index + 1;
 ``PATH#NAME`` for a file of several traces, no path for standard input) with ``--compat
-strem``; the first bad input ends the command (exit code 2). Exit codes: 0 some match, 1 none,
-2 error, 3 some file failed.
+strem``; the first bad input ends the command (exit code 2). The stream searches, the match lines
+and the warnings for names the data lacks (per input; for a live stream once it has ended) are
+:mod:`scenegrep.streams.spre`'s. Exit codes: 0 some match, 1 none, 2 error, 3 some file failed.
 """
 
 from __future__ import annotations

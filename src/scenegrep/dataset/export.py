@@ -11,9 +11,11 @@ time of the message is the window's start.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
+from ..errors import UserError
 from .results import Results
 
 TOPIC = "/scenegrep/matches"
@@ -58,7 +60,13 @@ def _time(ns: int) -> dict[str, int]:
 
 
 def event_of(row: dict[str, Any], run_id: str) -> tuple[int, dict[str, Any]]:
-    """The (log time in ns, foxglove.Event message) of a match row."""
+    """The (log time in ns, foxglove.Event message) of a match row; UserError for a row without
+    times (a STREM stream's frames carry none)."""
+    if not (math.isfinite(row["start_time"]) and math.isfinite(row["end_time"])):
+        raise UserError(
+            f"match {row['match']} of {row['name']}: the trace gives no time for its frames, and a Foxglove event "
+            "needs its start and end time"
+        )
     start = absolute_ns(row["time_origin_ns"] or 0, row["start_time"])
     end = absolute_ns(row["time_origin_ns"] or 0, row["end_time"])
     pairs = {

@@ -7,4 +7,6 @@ setup(ext_modules=[Extension("scenegrep.readers._strem", ["src/scenegrep/readers
                    Extension("scenegrep.readers._mcap_index", ["src/scenegrep/readers/_mcap_index.c"],
                              extra_compile_args=FLAGS),
                    Extension("scenegrep.readers.ros._cdr_copy", ["src/scenegrep/readers/ros/_cdr_copy.c"],
+                             extra_compile_args=FLAGS),
+                   Extension("scenegrep.readers.ros._cdr_walk", ["src/scenegrep/readers/ros/_cdr_walk.c"],
                              extra_compile_args=FLAGS)])

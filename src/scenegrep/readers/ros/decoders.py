@@ -35,6 +35,7 @@ import numpy as np
 
 from .cdr import Level, Payloads, decode
 from .cdr_layout import Layout, decode_same_layout
+from .cdr_walk import Program, Unsupported, decode_walked, program
 from .foxglove import SCENE_UPDATE, decode_scene_updates
 from .messages import Boxes, ImageBoxes, RawMessage, Transforms
 from .msgdef import Field, normalise, parse_schema
@@ -378,12 +379,27 @@ def supported(schema_name: str, message_encoding: str) -> bool:
 _LAYOUTS: dict[object, Layout] = {}
 """The last layout of each schema and field set decoded (:mod:`.cdr_layout`)."""
 
+_PROGRAMS: dict[object, Program | None] = {}
+"""The C walk's program of each schema and field set (:mod:`.cdr_walk`; None: walked in Python)."""
+
+
+def _walk_program(
+    types: dict[str, tuple[Field, ...]], key: str, wanted: frozenset[str], cache_key: object
+) -> Program | None:
+    if cache_key not in _PROGRAMS:
+        try:
+            _PROGRAMS[cache_key] = program(types, key, wanted)
+        except Unsupported:
+            _PROGRAMS[cache_key] = None
+    return _PROGRAMS[cache_key]
+
 
 def decode_batch(messages: Sequence[RawMessage]) -> Boxes | ImageBoxes | Transforms:
     """The boxes or links of a batch of messages of one topic (one supported schema and encoding):
     DecodeError names the first bad message; DefinitionError a schema that cannot be read; KeyError
     a field the decoder needs that the schema lacks. A batch of one layout is read with strided
-    views (:mod:`.cdr_layout`), any other with the generic walk: the same boxes or links."""
+    views (:mod:`.cdr_layout`), any other by the C walk (:mod:`.cdr_walk`), and a batch the walk
+    refuses by the generic walk, which names the bad message: the same boxes or links each way."""
     first = messages[0]
     if first.schema_name == SCENE_UPDATE:
         return decode_scene_updates(messages)
@@ -391,5 +407,8 @@ def decode_batch(messages: Sequence[RawMessage]) -> Boxes | ImageBoxes | Transfo
     wanted, build = _DECODERS[key](first.topic) if key in IMAGE_TYPES else _DECODERS[key]()
     types = types_of(first.schema_name, first.schema_data)
     data = [m.data for m in messages]
-    levels = decode_same_layout(types, key, wanted, data, _LAYOUTS, (first.schema_name, first.schema_data, wanted))
+    cache_key = (first.schema_name, first.schema_data, wanted)
+    levels = decode_same_layout(types, key, wanted, data, _LAYOUTS, cache_key)
+    if levels is None and (plan := _walk_program(types, key, wanted, cache_key)) is not None:
+        levels = decode_walked(plan, data)
     return build(levels if levels is not None else decode(types, key, Payloads.of(data), wanted))

@@ -1,0 +1,150 @@
+"""CDR messages of any layout decoded by a walk in C, one message after the other.
+
+:func:`program` compiles a type and the wanted fields (once per schema and field set) into rows
+that :mod:`._cdr_walk` follows for every message: a primitive (aligned, read or skipped), a
+plain struct skipped at once, a string, a sequence skipped at once, or a sequence whose
+elements are items of a level (their parent item and rank noted, their rows walked). Every read
+is bounded as the generic walk (:mod:`.cdr`) bounds it: nothing past a message's end, a count
+leaving room for its elements (``least`` bytes each, at least one). So the walk accepts exactly
+the messages the generic walk accepts; :func:`decode_walked` gives None at the first message it
+cannot walk (the caller then runs the generic walk, which names the fault), else the levels
+the generic walk gives (items in message order; a level exists once its sequence is reached,
+its fields once it has an item).
+
+The Python work is per batch and per field; the C loop per message and field.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _cdr_copy, _cdr_walk
+from .cdr import _DTYPES, HEADER, Level, Payloads, _Walker
+from .msgdef import PRIMITIVE_SIZES, STRINGS, Field
+
+PRIM, SKIP, STRING, SEQ_SKIP, SEQ = 1, 2, 3, 4, 5
+MAX_DEPTH = 32
+"""The deepest nesting of structs compiled (a deeper or recursive type: the generic walk)."""
+
+
+class Unsupported(ValueError):
+    """A type the program cannot express (nesting deeper than :data:`MAX_DEPTH`)."""
+
+
+@dataclass(frozen=True)
+class Program:
+    """A compiled walk: ``rows`` (n, 6) int64; ``levels`` the level names (``""`` first) and each
+    one's parent level; ``columns`` (level, path, dtype, values per item; dtype None: a string)."""
+
+    rows: np.ndarray
+    levels: tuple[tuple[str, str], ...]
+    columns: tuple[tuple[str, str, str | None, int], ...]
+
+
+def program(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozenset[str]) -> Program:
+    """The program of ``type_name`` keeping the ``wanted`` paths (see the module docstring)."""
+    plainer = _Walker(types, wanted, Payloads(np.zeros(0, np.uint8), np.zeros(0, np.int64), np.zeros(0, np.int64)))
+    prefixes = plainer._prefixes
+    rows: list[list[int]] = []
+    levels: list[tuple[str, str]] = [("", "")]
+    columns: list[tuple[str, str, str | None, int]] = []
+
+    def column(level: str, path: str, dtype: str | None, k: int) -> int:
+        columns.append((level, path, dtype, k))
+        return len(columns) - 1
+
+    def struct(name: str, level: str, prefix: str, depth: int) -> None:
+        if depth > MAX_DEPTH:
+            raise Unsupported(f"{name}: nested deeper than {MAX_DEPTH}")
+        for f in types[name]:
+            path = prefix + f.name
+            full = f"{level}.{path}" if level else path
+            want = full in prefixes
+            if f.type in PRIMITIVE_SIZES and f.count != -1:
+                size, k = PRIMITIVE_SIZES[f.type], 1 if f.count is None else f.count
+                if k:
+                    rows.append([PRIM, size, k, column(level, path, _DTYPES[f.type], k) if want else -1, 0, 0])
+            elif f.count is None and f.type in STRINGS:
+                rows.append([STRING, column(level, path, None, 1) if want else -1, 0, 0, 0, 0])
+            elif f.count is None:
+                plain = plainer.plain(f.type)
+                if plain is not None and not want:
+                    rows.append([SKIP, plain[0], plain[1], 0, 0, 0])
+                else:
+                    struct(f.type, level, path + ".", depth + 1)
+            else:
+                element = PRIMITIVE_SIZES.get(f.type) or (None if f.type in STRINGS else plainer.plain(f.type))
+                element = (element, element) if isinstance(element, int) else element
+                fixed = -1 if f.count == -1 else f.count
+                if element is not None and not want:
+                    rows.append([SEQ_SKIP, element[0], element[1], fixed, 0, 0])
+                    continue
+                levels.append((full, level))
+                at = len(rows)
+                rows.append([SEQ, len(levels) - 1, 0, element[0] if element else 1, fixed, 0])
+                if f.type in STRINGS:
+                    rows.append([STRING, column(full, "", None, 1), 0, 0, 0, 0])
+                elif f.type in PRIMITIVE_SIZES:
+                    rows.append([PRIM, PRIMITIVE_SIZES[f.type], 1, column(full, "", _DTYPES[f.type], 1), 0, 0])
+                else:
+                    struct(f.type, full, "", depth + 1)
+                rows[at][2] = len(rows) - at - 1
+
+    struct(type_name, "", "", 0)
+    return Program(np.array(rows, dtype=np.int64).reshape(len(rows), 6), tuple(levels), tuple(columns))
+
+
+def _texts(heap: bytes, places: np.ndarray) -> np.ndarray:
+    """The strings at (offset, length) rows of ``heap``, decoded once per distinct value (NULs
+    at the end dropped, as the generic walk decodes each)."""
+    out = np.empty(len(places), dtype=object)
+    decoded: dict[bytes, str] = {}
+    for i, (start, length) in enumerate(places.tolist()):
+        raw = heap[start : start + length]
+        text = decoded.get(raw)
+        if text is None:
+            text = decoded[raw] = raw.rstrip(b"\0").decode("utf-8", "replace")
+        out[i] = text
+    return out
+
+
+def decode_walked(plan: Program, payloads: Sequence) -> dict[str, Level] | None:
+    """The levels of a batch (each payload its bytes or a memoryview into its chunk), or None at
+    the first message the walk refuses (see the module docstring)."""
+    n = len(payloads)
+    address, size, owner = (np.empty(n, np.int64) for _ in range(3))
+    _cdr_copy.addresses(payloads, address, size, owner)
+    if (size < HEADER).any():
+        return None
+    count = len(plan.levels)
+    columns = [bytearray() for _ in plan.columns]
+    parents, ranks = [bytearray() for _ in range(count)], [bytearray() for _ in range(count)]
+    counts, reached = np.zeros(count, np.int64), np.zeros(count, np.int64)
+    counts[0] = reached[0] = n
+    heap = bytearray()
+    cuts = [0, *(np.flatnonzero(owner[1:] != owner[:-1]) + 1).tolist(), n]
+    for start, end in zip(cuts, cuts[1:]):
+        payload = payloads[start]
+        buffer = payload.obj if isinstance(payload, memoryview) else payload
+        base = np.frombuffer(buffer, dtype=np.uint8)
+        origins = address[start:end] - base.__array_interface__["data"][0] + HEADER
+        args = (columns, heap, parents, ranks, counts, reached, start)
+        if _cdr_walk.walk(base, origins, size[start:end] - HEADER, plan.rows, *args) >= 0:
+            return None
+    out: dict[str, Level] = {"": Level(np.arange(n, dtype=np.int64), np.zeros(n, dtype=np.int64), {})}
+    for k, (name, _) in enumerate(plan.levels[1:], start=1):
+        if reached[k]:
+            out[name] = Level(np.frombuffer(parents[k], np.int64), np.frombuffer(ranks[k], np.int64), {})
+    text = bytes(heap)
+    for (level, path, dtype, k), raw in zip(plan.columns, columns):
+        if level not in out or not len(out[level].parent):
+            continue
+        if dtype is None:
+            out[level].fields[path] = _texts(text, np.frombuffer(raw, np.int64).reshape(-1, 2))
+        else:
+            values = np.frombuffer(raw, dtype)
+            out[level].fields[path] = values if k == 1 else values.reshape(-1, k)
+    return out

@@ -17,7 +17,8 @@
  *     SEQ 5 (level, body, least, fixed): the elements (count as above), each an item of `level`:
  *            its parent item and rank appended (int64) to parents[level] and ranks[level], then
  *            the next `body` rows walked for it; those rows are skipped after the last element.
- *   A count must leave room for its elements (`least` bytes each, at least 1). counts[level]
+ *   A count (or a fixed array's size) must leave room for its elements (`least` bytes each, at
+ *   least 1; for a fixed array this is stricter than the generic walk, which then decodes it). counts[level]
  *   (int64, in and out) numbers each level's items; reached[level] (int64) is set to 1 when its
  *   SEQ row is walked. Message i is item first + i of the top level.
  *   Returns -1 when every message was walked, else the index of the first that could not be
@@ -136,8 +137,9 @@ static int64_t walk_rows(Walk *w, Py_ssize_t k, Py_ssize_t stop, int64_t pos, in
                 memcpy(&count, w->msg + pos, 4);
                 pos += 4;
                 n = count;
-                if (pos + n * (least > 1 ? least : 1) > w->end) return -1;
             }
+            /* (a fixed array too: its items are bounded by the bytes left, whatever the schema says) */
+            if (pos + n * (least > 1 ? least : 1) > w->end) return -1;
             if (r[0] == SEQ_SKIP) {
                 if (n > 0) pos = align(pos, r[2]);
                 pos += n * r[1];

@@ -5,9 +5,11 @@ that :mod:`._cdr_walk` follows for every message: a primitive (aligned, read or 
 plain struct skipped at once, a string, a sequence skipped at once, or a sequence whose
 elements are items of a level (their parent item and rank noted, their rows walked). Every read
 is bounded as the generic walk (:mod:`.cdr`) bounds it: nothing past a message's end, a count
-leaving room for its elements (``least`` bytes each, at least one). So the walk accepts exactly
-the messages the generic walk accepts; :func:`decode_walked` gives None at the first message it
-cannot walk (the caller then runs the generic walk, which names the fault), else the levels
+leaving room for its elements (``least`` bytes each, at least one). So the walk accepts the
+messages the generic walk accepts (but for a fixed-size array of more elements than bytes left,
+which it refuses, so a hostile schema cannot size its output); :func:`decode_walked` gives None at
+the first message it cannot walk (the caller then runs the generic walk, which names the fault or
+decodes it), else the levels
 the generic walk gives (items in message order; a level exists once its sequence is reached,
 its fields once it has an item).
 

@@ -181,13 +181,11 @@ def online_latency(frames: list[list], pattern: list[str], rate: float, warm_up:
     }
 
 
-def read_throughput(messages: int, objects: int, runs: int) -> dict:
-    """Messages per second read by the ros-bag reader (see the module docstring): medians of
-    ``runs`` runs."""
+def write_read_bench(path: Path, messages: int, objects: int) -> int:
+    """Write the read-throughput bag (see the module docstring) to ``path``; the bytes of one
+    TrackedObjects message."""
     from mcap_ros2._dynamic import serialize_dynamic
 
-    from scenegrep.readers.ros.bag import bag_messages
-    from scenegrep.readers.ros.reader import read_trace
     from scenegrep.writers.ros_bag import ORIGIN_NS
     from scenegrep.writers.ros_messages import Box, schema, tracked_object
 
@@ -214,28 +212,36 @@ def read_throughput(messages: int, objects: int, runs: int) -> dict:
     identity = {"translation": {"x": 0.0, "y": 0.0, "z": 0.0}, "rotation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}
     link = {"header": {**header, "frame_id": "map"}, "child_frame_id": "base_link", "transform": identity}
     tf_template = bytearray(encode_tf({"transforms": [link]}))
+    with open(path, "wb") as handle:
+        writer = Writer(handle, compression=CompressionType.ZSTD)
+        writer.start("ros2", "bench_bag")
+        objects_channel = writer.register_channel(
+            "/objects",
+            "cdr",
+            writer.register_schema("autoware_perception_msgs/msg/TrackedObjects", "ros2msg", objects_schema.encode()),
+        )
+        tf_channel = writer.register_channel(
+            "/tf", "cdr", writer.register_schema("tf2_msgs/msg/TFMessage", "ros2msg", tf_schema.encode())
+        )
+        for i in range(messages):
+            stamp = ORIGIN_NS + i * 100_000_000
+            sec, nanosec = (stamp // 10**9).to_bytes(4, "little"), (stamp % 10**9).to_bytes(4, "little")
+            template[4:12] = tf_template[8:16] = sec + nanosec  # header stamps (the tf one after its count)
+            writer.add_message(tf_channel, stamp, bytes(tf_template), stamp)
+            writer.add_message(objects_channel, stamp, bytes(template), stamp)
+        writer.finish()
+    return len(template)
+
+
+def read_throughput(messages: int, objects: int, runs: int) -> dict:
+    """Messages per second read by the ros-bag reader (see the module docstring): medians of
+    ``runs`` runs."""
+    from scenegrep.readers.ros.bag import bag_messages
+    from scenegrep.readers.ros.reader import read_trace
+
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "bench.mcap"
-        with open(path, "wb") as handle:
-            writer = Writer(handle, compression=CompressionType.ZSTD)
-            writer.start("ros2", "bench_bag")
-            objects_channel = writer.register_channel(
-                "/objects",
-                "cdr",
-                writer.register_schema(
-                    "autoware_perception_msgs/msg/TrackedObjects", "ros2msg", objects_schema.encode()
-                ),
-            )
-            tf_channel = writer.register_channel(
-                "/tf", "cdr", writer.register_schema("tf2_msgs/msg/TFMessage", "ros2msg", tf_schema.encode())
-            )
-            for i in range(messages):
-                stamp = ORIGIN_NS + i * 100_000_000
-                sec, nanosec = (stamp // 10**9).to_bytes(4, "little"), (stamp % 10**9).to_bytes(4, "little")
-                template[4:12] = tf_template[8:16] = sec + nanosec  # header stamps (the tf one after its count)
-                writer.add_message(tf_channel, stamp, bytes(tf_template), stamp)
-                writer.add_message(objects_channel, stamp, bytes(template), stamp)
-            writer.finish()
+        size = write_read_bench(path, messages, objects)
         stream, read, cpu = [], [], []
         for _ in range(runs):  # alternated, so both see the same load of a shared machine
             start = time.perf_counter()
@@ -249,7 +255,7 @@ def read_throughput(messages: int, objects: int, runs: int) -> dict:
     return {
         "messages": messages,
         "objects_per_message": objects,
-        "bytes_per_message": len(template),
+        "bytes_per_message": size,
         "runs": runs,
         "load_average": os.getloadavg()[0],
         "mcap_stream_messages_per_s": round(statistics.median(stream)),

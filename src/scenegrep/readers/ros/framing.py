@@ -4,7 +4,10 @@
 batch of :class:`RawMessage` (in arrival order) and returns a :class:`LabelTrace` of the frames
 that batch completed (None if none); :meth:`FrameBuilder.finish` returns the frames left at
 the end of input. Fed one message at a time, each chunk is one frame as soon as it is
-complete; the offline reader feeds large batches and concatenates the chunks.
+complete; the offline reader feeds large batches through :meth:`FrameBuilder.run`, which makes
+one trace of all of them at the end (the chunks, concatenated). Rows carry object ids, classes
+and frame ids as integer codes (:class:`_Names`); the strings are looked at once per distinct
+value of a batch, and the trace's objects are named once at the end.
 
 **Frames.** On a frame topic (``frame_topic``; by default the first box topic met), every
 message of that topic is a frame at its header stamp, holding its boxes and, of every other
@@ -39,20 +42,22 @@ end of input is a :class:`UserError` naming the topic and the message's log time
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
+from operator import itemgetter
 
 import numpy as np
 
 from ...errors import UserError
 from ...model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
 from ...model.geometry import heading_from_yaw
+from ...model.images import concatenate_layers
 from ...model.trace import EGO_SIZE_UNKNOWN
 from .decoders import BOX_TYPES, LINK_TYPES, decode_batch, supported, type_key
-from .messages import Boxes, DecodeError, ImageBoxes, RawMessage
+from .messages import Boxes, Coded, DecodeError, ImageBoxes, RawMessage
 from .msgdef import DefinitionError
 from .options import BagOptions
-from .transforms import MissingTransform, TfBuffer, quat_multiply, quat_rotate, yaw_of
+from .transforms import MissingTransform, TfBuffer, product, rotated, yaw, yaw_of
 
 EGO_ID = "ego"
 """The object id of the ego (the pose of ``ego_frame``)."""
@@ -64,18 +69,79 @@ MAX_MESSAGE_BYTES = 256 << 20
 """The largest message decoded (a TrackedObjects message of 1,000 objects is about 500 kB)."""
 
 
+_KIND = itemgetter(1, 4)  # a RawMessage's schema name and message encoding
+_LOG_TIME = itemgetter(5)
+_DATA = itemgetter(6)
+
+
+class _Names:
+    """Strings numbered in order of first sight: the builder's codes of object ids, classes and
+    frame ids (rows carry codes; a string is looked at once per distinct value of a batch)."""
+
+    def __init__(self) -> None:
+        self.index: dict[str, int] = {}
+        self.names: list[str] = []
+
+    def __len__(self) -> int:
+        return len(self.names)
+
+    def code(self, name: str) -> int:
+        """The code of ``name`` (a new one the first time)."""
+        code = self.index.get(name)
+        if code is None:
+            code = self.index[name] = len(self.names)
+            self.names.append(name)
+        return code
+
+    def codes(self, column: np.ndarray | Coded) -> np.ndarray:
+        """The code of every row of a string column."""
+        coded = column if isinstance(column, Coded) else Coded.of(column)
+        table = np.fromiter(map(self.code, coded.names.tolist()), dtype=np.int64, count=len(coded.names))
+        return table[coded.codes]
+
+
 @dataclass
 class _Segment:
-    """The boxes of one decoded batch of one topic, and its messages' stamps and log times."""
+    """The boxes of one decoded batch of one topic, its messages' stamps and log times, and (3-D
+    boxes) the builder's codes of every row's object id, class and frame id."""
 
     topic: str
-    boxes: Boxes
+    boxes: Boxes | ImageBoxes
     stamps: np.ndarray
     log_times: np.ndarray
+    ids: np.ndarray | None = None
+    classes: np.ndarray | None = None
+    frames: np.ndarray | None = None
     alive: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
         self.alive = np.ones(len(self.stamps), dtype=bool)
+
+    def rows(self, messages: np.ndarray) -> np.ndarray | slice:
+        """The rows of the boxes of ``messages`` (positions, each once): a boolean mask, or every
+        row (a slice) when they are every message."""
+        if len(messages) == len(self.stamps):
+            return slice(None)
+        chosen = np.zeros(len(self.stamps), dtype=bool)
+        chosen[messages] = True
+        return chosen[self.boxes.message]
+
+
+@dataclass
+class _Part:
+    """The frames one emission completed, before they become a trace: their ``stamps`` (ns),
+    ``times`` (s from the origin), and per row (in frame order, topics in pick order, the ego
+    last): its ``frame`` (position among these frames), the builder's ``ids`` and ``classes``
+    codes, and ``values`` (9, n): x, y, z, heading, length, width, height, vx, vy."""
+
+    stamps: np.ndarray
+    times: np.ndarray
+    frame: np.ndarray
+    ids: np.ndarray
+    classes: np.ndarray
+    values: np.ndarray
+    has_ego: bool
+    images: ImageLayer | None
 
 
 def _fail(topic: str, log_time: int, reason: str) -> UserError:
@@ -105,10 +171,30 @@ class FrameBuilder:
         self.last_stamp: int | None = None
         self.origin: int | None = None
         self.newest = np.iinfo(np.int64).min
+        self.ids, self.classes, self.frames = _Names(), _Names(), _Names()
+        self.map_code = self.frames.code(options.map_frame)
 
     # ------------------------------------------------------------------ input
     def feed(self, batch: Sequence[RawMessage]) -> LabelTrace | None:
         """Take a batch of messages; the frames it completed, or None."""
+        part = self._feed(batch)
+        return None if part is None else self._trace([part])
+
+    def finish(self) -> LabelTrace | None:
+        """The frames left at the end of input; notes unknown topics and late messages on stderr."""
+        part = self._finish()
+        return None if part is None else self._trace([part])
+
+    def run(self, batches: Iterable[Sequence[RawMessage]]) -> LabelTrace | None:
+        """Feed every batch and finish: all the frames as one trace (the chunks :meth:`feed` and
+        :meth:`finish` would give, concatenated), or None when no frame was built. Each batch's
+        frames are kept as codes and arrays; the trace is made once, at the end."""
+        parts = [part for batch in batches if (part := self._feed(batch)) is not None]
+        last = self._finish()
+        parts += [last] if last is not None else []
+        return self._trace(parts) if parts else None
+
+    def _feed(self, batch: Sequence[RawMessage]) -> _Part | None:
         by_topic: dict[str, list[RawMessage]] = {}
         for message in batch:
             by_topic.setdefault(message.topic, []).append(message)
@@ -116,15 +202,14 @@ class FrameBuilder:
             self._topic(topic, messages)
         return self._emit(final=False)
 
-    def finish(self) -> LabelTrace | None:
-        """The frames left at the end of input; notes unknown topics and late messages on stderr."""
-        chunk = self._emit(final=True)
+    def _finish(self) -> _Part | None:
+        part = self._emit(final=True)
         if self.skipped:
             listed = ", ".join(f"{t} ({k})" for t, k in self.skipped.items())
             self.note(f"skipped topics of unsupported types: {listed}")
         if self.late:
             self.note(f"{self.late} box messages arrived after their frame was built and were dropped")
-        return chunk
+        return part
 
     def _topic(self, topic: str, messages: list[RawMessage]) -> None:
         first = messages[0]
@@ -135,11 +220,13 @@ class FrameBuilder:
         chosen = not self.options.topics or topic in self.options.topics
         if not chosen and not (kind == "tf2_msgs/TFMessage" and topic in ("/tf", STATIC_TOPIC)):
             return
-        for m in messages:
-            if len(m.data) > MAX_MESSAGE_BYTES:
-                raise _fail(topic, m.log_time, f"a message of {len(m.data)} bytes (at most {MAX_MESSAGE_BYTES})")
-            if (m.schema_name, m.message_encoding) != (first.schema_name, first.message_encoding):
-                raise _fail(topic, m.log_time, f"type {m.schema_name} on a topic of type {first.schema_name}")
+        kinds = list(map(_KIND, messages))
+        if max(map(len, map(_DATA, messages))) > MAX_MESSAGE_BYTES or kinds.count(kinds[0]) != len(kinds):
+            for m in messages:  # the first bad message
+                if len(m.data) > MAX_MESSAGE_BYTES:
+                    raise _fail(topic, m.log_time, f"a message of {len(m.data)} bytes (at most {MAX_MESSAGE_BYTES})")
+                if (m.schema_name, m.message_encoding) != (first.schema_name, first.message_encoding):
+                    raise _fail(topic, m.log_time, f"type {m.schema_name} on a topic of type {first.schema_name}")
         try:
             decoded = decode_batch(messages)
         except DecodeError as exc:
@@ -151,14 +238,18 @@ class FrameBuilder:
         if kind in LINK_TYPES:
             self.tf.add(decoded, static=topic == STATIC_TOPIC)  # type: ignore[arg-type]
         elif kind in BOX_TYPES:
-            self._boxes(topic, decoded, np.array([m.log_time for m in messages], dtype=np.int64))  # type: ignore[arg-type]
+            log_times = np.fromiter(map(_LOG_TIME, messages), dtype=np.int64, count=len(messages))
+            self._boxes(topic, decoded, log_times)  # type: ignore[arg-type]
 
-    def _boxes(self, topic: str, boxes: Boxes, log_times: np.ndarray) -> None:
+    def _boxes(self, topic: str, boxes: Boxes | ImageBoxes, log_times: np.ndarray) -> None:
         if self.frame_topic is None and self.options.rate is None:
             self.frame_topic = topic
         if self.origin is None and self.options.rate is not None:
             self.origin = int(boxes.message_stamps.min())
         segment = _Segment(topic, boxes, boxes.message_stamps, log_times)
+        if isinstance(boxes, Boxes):
+            segment.ids, segment.classes = self.ids.codes(boxes.id), self.classes.codes(boxes.category)
+            segment.frames = self.frames.codes(boxes.frame_id)
         if self.last_stamp is not None:
             late = segment.stamps <= self.last_stamp
             if self.options.rate is not None:
@@ -196,7 +287,7 @@ class FrameBuilder:
         return np.arange(first, last + 1, period, dtype=np.int64) if last >= first else np.empty(0, np.int64)
 
     def _messages(self, stamps: np.ndarray) -> list[tuple[_Segment, np.ndarray, np.ndarray]]:
-        """For frames at ``stamps``: per segment, the messages each frame takes and their frames."""
+        """For frames at ``stamps``: per segment (by topic), the messages each frame takes and their frames."""
         previous = self.last_stamp if self.last_stamp is not None else np.iinfo(np.int64).min
         chosen = []
         for segment in self.segments:
@@ -213,15 +304,17 @@ class FrameBuilder:
                 frame = np.searchsorted(stamps, s, side="left")
                 keep = (frame < len(stamps)) & (s > previous)
             chosen.append((segment, rows[keep], frame[keep]))
-        return [self._latest_per_frame(items) for items in _by_topic(chosen).values()]
+        return [p for items in _by_topic(chosen).values() for p in self._latest_per_frame(items)]
 
     @staticmethod
     def _latest_per_frame(items: list[tuple[_Segment, np.ndarray, np.ndarray]]) -> list:
         """Of one topic's messages, the latest stamped (the last received on a tie) per frame."""
-        stamps = np.concatenate([seg.stamps[rows] for seg, rows, _ in items])
-        if not len(stamps):  # none of its messages falls in these frames (one message fed at a time)
+        if len(items) == 1 and len(items[0][1]) < 2:
             return items
+        stamps = np.concatenate([seg.stamps[rows] for seg, rows, _ in items])
         frames = np.concatenate([f for _, _, f in items])
+        if (frames[1:] > frames[:-1]).all():  # one message per frame already
+            return items
         arrival = np.arange(len(stamps))
         order = np.lexsort((arrival, stamps, frames))
         last = np.r_[frames[order][1:] != frames[order][:-1], True]
@@ -234,101 +327,135 @@ class FrameBuilder:
             start += len(rows)
         return out
 
-    def _needed(self, picks: list) -> dict[str, int]:
-        """The latest stamp at which the chosen boxes need a transform, by frame id (the map frame
-        needs none)."""
-        need: dict[str, int] = {}
-        for seg, rows, _ in picks:
-            if isinstance(seg.boxes, ImageBoxes):
+    def _needed(self, picks: list) -> dict[int, int]:
+        """The latest stamp at which the chosen boxes need a transform, by frame id code (the map
+        frame needs none)."""
+        need: dict[int, int] = {}
+        for seg, messages, _ in picks:
+            if seg.frames is None:
                 continue
-            rows_of = np.isin(seg.boxes.message, rows)
-            for frame_id in set(seg.boxes.frame_id[rows_of].tolist()):
-                if frame_id != self.options.map_frame:
-                    at = int(seg.boxes.stamp[rows_of][seg.boxes.frame_id[rows_of] == frame_id].max())
-                    need[frame_id] = max(need.get(frame_id, at), at)
+            rows = seg.rows(messages)
+            codes, stamps = seg.frames[rows], seg.boxes.stamp[rows]
+            present = np.flatnonzero(np.bincount(codes, minlength=1))
+            for code in present.tolist():
+                if code != self.map_code:
+                    at = int(stamps.max() if len(present) == 1 else stamps[codes == code].max())
+                    need[code] = max(need.get(code, at), at)
         return need
 
-    def _ready(self, stamps: np.ndarray, final: bool) -> int:
-        """How many of the candidate frames can be emitted now."""
-        if final or not len(stamps):
-            return len(stamps)
-        ego = self.tf.latest(self.options.ego_frame, self.options.map_frame)
-        ready = len(stamps) if ego is None else int(np.searchsorted(stamps, ego, side="right"))
+    def _ready(self, stamps: np.ndarray, final: bool) -> tuple[int, list]:
+        """How many of the candidate frames can be emitted now, and their picks (:meth:`_messages`)."""
+        ready = len(stamps)
+        if not final and len(stamps):
+            ego = self.tf.latest(self.options.ego_frame, self.options.map_frame)
+            ready = len(stamps) if ego is None else int(np.searchsorted(stamps, ego, side="right"))
         while ready:
-            picks = [p for topic in self._messages(stamps[:ready]) for p in topic]
+            picks = self._messages(stamps[:ready])
+            if final:
+                return ready, picks
             need = self._needed(picks)
-            if all((self.tf.latest(f, self.options.map_frame) or -1) >= at for f, at in need.items()):
-                return ready
+            names = self.frames.names
+            if all((self.tf.latest(names[f], self.options.map_frame) or -1) >= at for f, at in need.items()):
+                return ready, picks
             ready -= 1
-        return 0
+        return 0, []
 
-    def _emit(self, final: bool) -> LabelTrace | None:
+    def _emit(self, final: bool) -> _Part | None:
         stamps = self._candidates(final)
-        stamps = stamps[: self._ready(stamps, final)]
+        ready, picks = self._ready(stamps, final)
+        stamps = stamps[:ready]
         if not len(stamps):
             return None
-        picks = [p for topic in self._messages(stamps) for p in topic]
-        chunk = self._chunk(stamps, picks)
+        part = self._part(stamps, picks)
         self.last_stamp = int(stamps[-1])
         horizon = self.last_stamp + (self._period() - 1 if self.options.rate is not None else 0)
         for segment in self.segments:
             segment.alive &= segment.stamps > horizon
         self.segments = [s for s in self.segments if s.alive.any()]
-        return chunk
+        return part
 
     # ------------------------------------------------------------------ building
-    def _chunk(self, stamps: np.ndarray, picks: list) -> LabelTrace:
-        images = _image_layer([p for p in picks if isinstance(p[0].boxes, ImageBoxes)])
-        parts = []
-        for seg, rows, frames in picks:
-            if isinstance(seg.boxes, ImageBoxes):
+    def _part(self, stamps: np.ndarray, picks: list) -> _Part:
+        """The rows of the frames at ``stamps`` from their picks (:meth:`_messages`) and the ego."""
+        if self.origin is None:
+            self.origin = int(stamps[0])
+        images = _image_layer([p for p in picks if p[0].frames is None])
+        frame, ids, classes, values = [], [], [], []
+        for seg, messages, frames in picks:
+            if seg.frames is None:
                 continue
             frame_of = np.full(len(seg.stamps), -1)
-            frame_of[rows] = frames
-            taken = seg.boxes.take(frame_of[seg.boxes.message] >= 0)
-            parts.append((seg, taken, frame_of[taken.message]))
-        ids, categories, frame, columns = [], [], [], []
-        for seg, boxes, frames in parts:
-            if not len(boxes):
+            frame_of[messages] = frames
+            rows = seg.rows(messages)
+            if isinstance(rows, np.ndarray) and not rows.any():
                 continue
-            xyz, quat = self._to_map(seg, boxes)
-            velocity = quat_rotate(quat, boxes.velocity)
-            ids.append(boxes.id)
-            categories.append(boxes.category)
-            frame.append(frames)
-            columns.append(np.column_stack([xyz, heading_from_yaw(yaw_of(quat)), boxes.size, velocity[:, :2]]))
+            frame.append(frame_of[seg.boxes.message[rows]])
+            ids.append(seg.ids[rows])  # type: ignore[index]
+            classes.append(seg.classes[rows])  # type: ignore[index]
+            values.append(self._values(seg, rows))
         ego = self._ego(stamps)
         if ego is not None:
-            ids.append(np.full(len(stamps), EGO_ID, dtype=object))
-            categories.append(np.full(len(stamps), EGO_ID, dtype=object))
             frame.append(np.arange(len(stamps)))
-            columns.append(ego)
-        return self._trace(stamps, ids, categories, frame, columns, ego is not None, images)
+            ids.append(np.full(len(stamps), self.ids.code(EGO_ID)))
+            classes.append(np.full(len(stamps), self.classes.code(EGO_ID)))
+            values.append(ego)
+        frame_all = np.concatenate(frame) if frame else np.empty(0, np.int64)
+        ids_all = np.concatenate(ids) if ids else np.empty(0, np.int64)
+        classes_all = np.concatenate(classes) if classes else np.empty(0, np.int64)
+        values_all = _columns(values)
+        if not (frame_all[1:] >= frame_all[:-1]).all():
+            by_frame = np.argsort(frame_all, kind="stable")
+            frame_all, ids_all, classes_all = frame_all[by_frame], ids_all[by_frame], classes_all[by_frame]
+            values_all = np.take(values_all, by_frame, axis=1)
+        return _Part(
+            stamps, (stamps - self.origin) / 1e9, frame_all, ids_all, classes_all, values_all, ego is not None, images
+        )
 
-    def _to_map(self, seg: _Segment, boxes: Boxes) -> tuple[np.ndarray, np.ndarray]:
-        xyz, quat = boxes.xyz.copy(), boxes.quat.copy()
-        for frame_id in set(boxes.frame_id.tolist()):
-            if frame_id == self.options.map_frame:
-                continue
-            rows = np.flatnonzero(boxes.frame_id == frame_id)
-            # one lookup per distinct stamp (the objects of a message share theirs)
-            stamps, each = np.unique(boxes.stamp[rows], return_inverse=True)
-            try:
-                t, q = self.tf.lookup(frame_id, self.options.map_frame, stamps)
-            except MissingTransform:
-                try:  # again per row, for the row the error names
-                    self.tf.lookup(frame_id, self.options.map_frame, boxes.stamp[rows])
-                except MissingTransform as exc:
-                    raise _fail(seg.topic, int(seg.log_times[boxes.message[rows[exc.row]]]), exc.reason) from None
-                raise
-            t, q = t[each.ravel()], q[each.ravel()]
-            xyz[rows] = quat_rotate(q, xyz[rows]) + t
-            quat[rows] = quat_multiply(q, quat[rows])
-        return xyz, quat
+    def _values(self, seg: _Segment, rows: np.ndarray | slice) -> np.ndarray:
+        """The (9, n) state values of ``rows`` of a segment's boxes (:class:`_Part`): each box moved
+        into the map frame with the transform of its frame id at its stamp, its heading the yaw of
+        its rotation there, its velocity turned by that rotation."""
+        boxes: Boxes = seg.boxes  # type: ignore[assignment]
+        xyz, quat, velocity, codes = boxes.xyz[rows], boxes.quat[rows], boxes.velocity[rows], seg.frames[rows]  # type: ignore[index]
+        out = np.empty((9, len(codes)))
+        out[4:7] = boxes.size[rows].T
+        present = np.flatnonzero(np.bincount(codes, minlength=1)).tolist()
+        for code in present:
+            group = slice(None) if len(present) == 1 else np.flatnonzero(codes == code)
+            position, rotation = tuple(xyz[group].T), tuple(quat[group].T)
+            if code != self.map_code:
+                t, q = self._transforms(seg, rows, group, code)
+                position = tuple(p + s for p, s in zip(rotated(q, position), t))
+                rotation = product(q, rotation)
+            out[0, group], out[1, group], out[2, group] = position
+            out[3, group] = heading_from_yaw(yaw(rotation))
+            out[7, group], out[8, group], _ = rotated(rotation, tuple(velocity[group].T))
+        return out
+
+    def _transforms(
+        self, seg: _Segment, rows: np.ndarray | slice, group: np.ndarray | slice, code: int
+    ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        """The translation and rotation components (:data:`.transforms.Components`) of frame id
+        ``code`` in the map frame at the stamp of each box of ``group`` of ``rows`` (one lookup per
+        distinct stamp; a stamp without a transform is a :class:`UserError` naming the box's message)."""
+        boxes: Boxes = seg.boxes  # type: ignore[assignment]
+        stamps = boxes.stamp[rows][group]
+        distinct, each = _distinct(stamps)
+        frame_id = self.frames.names[code]
+        try:
+            t, q = self.tf.lookup(frame_id, self.options.map_frame, distinct)
+        except MissingTransform:
+            try:  # again per row, for the row the error names
+                self.tf.lookup(frame_id, self.options.map_frame, stamps)
+            except MissingTransform as exc:
+                message = boxes.message[rows][group][exc.row]
+                raise _fail(seg.topic, int(seg.log_times[message]), exc.reason) from None
+            raise
+        return [c[each] for c in t.T], [c[each] for c in q.T]
 
     def _ego(self, stamps: np.ndarray) -> np.ndarray | None:
-        """Rows (x, y, z, heading, length, width, height, vx, vy) of the ego at ``stamps``, or None
-        when the ego frame does not reach the map frame."""
+        """The (9, n) state values of the ego at ``stamps`` (:class:`_Part`), or None when the ego
+        frame does not reach the map frame."""
         if self.tf.chain(self.options.ego_frame, self.options.map_frame) in (None, []):
             return None
         try:
@@ -339,7 +466,7 @@ class FrameBuilder:
             ) from None
         size = np.tile(np.asarray(self.options.ego_size or (np.nan,) * 3, dtype=float), (len(stamps), 1))
         velocity = self.tf.velocity(self.options.ego_frame, self.options.map_frame, stamps, quat)
-        return np.column_stack([xyz, heading_from_yaw(yaw_of(quat)), size, velocity[:, :2]])
+        return np.column_stack([xyz, heading_from_yaw(yaw_of(quat)), size, velocity[:, :2]]).T
 
     def _ego_size_note(self) -> dict[str, str]:
         """The :data:`EGO_SIZE_UNKNOWN` attribute when the options give no ego size."""
@@ -350,52 +477,54 @@ class FrameBuilder:
             "bag is read (a dataset ingested it without: query the bag as a file)"
         }
 
-    def _trace(self, stamps, ids, categories, frame, columns, has_ego: bool, images: ImageLayer | None) -> LabelTrace:
-        if self.origin is None:
-            self.origin = int(stamps[0])
-        frame_all = np.concatenate(frame).astype(np.int64) if frame else np.empty(0, np.int64)
-        by_frame = np.argsort(frame_all, kind="stable")
-        frame_all = frame_all[by_frame]
-        ids_all = (np.concatenate(ids) if ids else np.empty(0, dtype=object))[by_frame]
-        values = (np.concatenate(columns) if columns else np.empty((0, 9)))[by_frame]
-        category_all = (np.concatenate(categories) if categories else np.empty(0, dtype=object))[by_frame]
-        # objects in the order they first appear (so chunks concatenate to the same table)
-        inverse, index = _codes(ids_all)
-        names = np.array(list(index), dtype=object)
-        # codes are numbered in order of first appearance: a code is new where it passes every earlier one
-        seen = np.maximum.accumulate(inverse) if len(inverse) else inverse
-        first = np.flatnonzero(np.r_[len(inverse) > 0, inverse[1:] > seen[:-1]])
-        category = category_all[first]
-        key = frame_all * max(len(names), 1) + inverse
-        order = np.argsort(key, kind="stable")
-        unique_rows = order[np.r_[True, key[order][1:] != key[order][:-1]]] if len(key) else order
-        x, y, z, heading, length, width, height, vx, vy = values[unique_rows].T
+    def _trace(self, parts: list[_Part]) -> LabelTrace:
+        """One trace of consecutive parts, the first of them emitted as frame ``self.emitted``:
+        objects numbered in order of first appearance, each with its class there; of the rows
+        of one object in one frame the first is kept."""
+        offsets = np.cumsum([0] + [len(p.stamps) for p in parts])
+        frame = np.concatenate([p.frame + offset for p, offset in zip(parts, offsets)])
+        ids = np.concatenate([p.ids for p in parts])
+        classes = np.concatenate([p.classes for p in parts])
+        values = _columns([p.values for p in parts])
+        n = len(frame)
+        first = np.full(len(self.ids), n, dtype=np.int64)  # rows are in frame order
+        np.minimum.at(first, ids, np.arange(n))
+        seen = np.flatnonzero(first < n)
+        objects = seen[np.argsort(first[seen], kind="stable")]
+        number = np.empty(len(self.ids), dtype=np.int64)
+        number[objects] = np.arange(len(objects))
+        obj = number[ids]
+        key = frame * max(len(objects), 1) + obj
+        if not (key[1:] > key[:-1]).all():  # an object twice in a frame, or objects out of order
+            order = np.argsort(key, kind="stable")
+            keep = order[np.r_[True, key[order][1:] != key[order][:-1]]] if n else order
+            frame, obj, values = frame[keep], obj[keep], np.take(values, keep, axis=1)
+        x, y, z, heading, length, width, height, vx, vy = values
         states = StateTable.build(
-            frame_all[unique_rows],
-            inverse[unique_rows],
-            x,
-            y,
-            heading,
-            z=z,
-            length=length,
-            width=width,
-            height=height,
-            vx=vx,
-            vy=vy,
+            frame, obj, x, y, heading, z=z, length=length, width=width, height=height, vx=vx, vy=vy
         )
-        chunk = LabelTrace.build(
+        names, class_names = self.ids.names, self.classes.names
+        objects_table = ObjectTable.build(
+            [names[k] for k in objects.tolist()], [str(class_names[c]) for c in classes[first[objects]].tolist()]
+        )
+        images = (
+            parts[0].images
+            if len(parts) == 1
+            else concatenate_layers([(p.images, int(o), np.empty(0, np.int32)) for p, o in zip(parts, offsets)])
+        )
+        trace = LabelTrace.build(
             self.name,
-            np.arange(self.emitted, self.emitted + len(stamps)),
-            (stamps - self.origin) / 1e9,
-            ObjectTable.build(names.tolist(), [str(c) for c in category]),
+            np.arange(self.emitted, self.emitted + int(offsets[-1])),
+            np.concatenate([p.times for p in parts]),
+            objects_table,
             states,
-            ego=EGO_ID if has_ego else None,
+            ego=EGO_ID if parts[0].has_ego else None,
             images=images,
             attributes={"dataset": "ros2-bag", "time_origin_ns": self.origin, **self._ego_size_note()},
             source=self.source,
         )
-        self.emitted += len(stamps)
-        return chunk
+        self.emitted += int(offsets[-1])
+        return trace
 
 
 def _image_layer(picks: list[tuple[_Segment, np.ndarray, np.ndarray]]) -> ImageLayer | None:
@@ -463,17 +592,20 @@ def _by_topic(chosen: list[tuple[_Segment, np.ndarray, np.ndarray]]) -> dict[str
     return out
 
 
-def _codes(ids: np.ndarray) -> tuple[np.ndarray, dict[str, int]]:
-    """Each of ``ids`` (strings) numbered in order of first appearance, and the numbering. The
-    rows are grouped by string object first (a decoder repeats one object per distinct id, so
-    the Python work is per distinct object, not per row)."""
-    objects = np.fromiter(map(id, ids), dtype=np.int64, count=len(ids))
-    _, first, inverse = np.unique(objects, return_index=True, return_inverse=True)
-    index: dict[str, int] = {}
-    code = np.empty(len(first), dtype=np.int64)
-    for k in np.argsort(first, kind="stable").tolist():
-        code[k] = index.setdefault(ids[first[k]], len(index))
-    return code[inverse.ravel()], index
+def _columns(parts: list[np.ndarray]) -> np.ndarray:
+    """(9, n) value arrays side by side, as one C-ordered array (its rows are the state columns)."""
+    out = np.empty((9, sum(p.shape[1] for p in parts)))
+    return np.concatenate(parts, axis=1, out=out) if parts else out
+
+
+def _distinct(stamps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct values of ``stamps`` (sorted) and the position of each stamp among them; no
+    sort when they are in order already (the rows of a batch are, message after message)."""
+    if (stamps[1:] >= stamps[:-1]).all():
+        new = np.r_[True, stamps[1:] != stamps[:-1]]
+        return stamps[new], np.cumsum(new) - 1
+    distinct, each = np.unique(stamps, return_inverse=True)
+    return distinct, each.ravel()
 
 
 def frames(
@@ -482,13 +614,6 @@ def frames(
     name: str,
     source: TraceSource | None = None,
     note: Callable[[str], None] | None = None,
-) -> Iterator[LabelTrace]:
-    """The chunks of frames completed by each batch of messages, then the rest at the end."""
-    builder = FrameBuilder(options, name, source, note)
-    for batch in batches:
-        chunk = builder.feed(batch)
-        if chunk is not None:
-            yield chunk
-    chunk = builder.finish()
-    if chunk is not None:
-        yield chunk
+) -> LabelTrace | None:
+    """Every frame of the batches of messages as one trace, or None (:meth:`FrameBuilder.run`)."""
+    return FrameBuilder(options, name, source, note).run(batches)

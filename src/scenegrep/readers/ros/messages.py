@@ -5,7 +5,9 @@ A :class:`RawMessage` is one message as a bag or MCAP stream holds it (the recor
 reader feeds this pipeline as is). Decoders turn a batch of
 raw messages of one type into :class:`Boxes` (3-D objects, poses in their message's frame) or
 :class:`Transforms` (time-stamped frame links, from ``/tf`` or an odometry topic). Times are
-integer nanoseconds; lengths metres; quaternions (x, y, z, w).
+integer nanoseconds; lengths metres; quaternions (x, y, z, w). A column of strings (ids, classes,
+frame ids) is an object array of ``str`` or a :class:`Coded` (codes into a table of names), so
+the pipeline can work per distinct value, not per row.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import numpy as np
 
 from ..mcap_records import RawMessage
 
-__all__ = ["Boxes", "DecodeError", "RawMessage", "Transforms"]
+__all__ = ["Boxes", "Coded", "DecodeError", "RawMessage", "Transforms"]
 
 
 class DecodeError(ValueError):
@@ -28,19 +30,50 @@ class DecodeError(ValueError):
 
 
 @dataclass(frozen=True)
+class Coded:
+    """A column of strings as integer ``codes`` (n,) into ``names`` (an object array of ``str``):
+    row i is ``names[codes[i]]``. Names need not be distinct nor all used."""
+
+    codes: np.ndarray
+    names: np.ndarray
+
+    @classmethod
+    def of(cls, strings: np.ndarray) -> Coded:
+        """The column of an object array of strings; the rows that hold one string object share a
+        code, so the Python work is per distinct object, not per row (a decoder that repeats one
+        object per distinct value gives each value one name)."""
+        strings = np.asarray(strings, dtype=object)
+        objects = np.fromiter(map(id, strings), dtype=np.int64, count=len(strings))
+        _, first, codes = np.unique(objects, return_index=True, return_inverse=True)
+        return cls(codes.ravel(), strings[first])
+
+    def __len__(self) -> int:
+        return len(self.codes)
+
+    def __getitem__(self, rows: np.ndarray | slice) -> Coded:
+        """The rows selected by an index array, a boolean array or a slice."""
+        return Coded(self.codes[rows], self.names)
+
+    def strings(self) -> np.ndarray:
+        """The column as an object array of strings."""
+        return self.names[self.codes]
+
+
+@dataclass(frozen=True)
 class Boxes:
     """3-D boxes, one row per object observation: ``message`` (position of its message in the
     decoded batch), ``stamp`` (its header stamp, ns), ``frame_id`` (frame of its pose), ``id``
-    (track id; '' when the message gives none), ``category`` (class name), position ``xyz``
+    (track id; '' when the message gives none), ``category`` (class name) (these three: object
+    arrays of ``str`` or :class:`Coded`), position ``xyz``
     (n, 3), orientation ``quat`` (n, 4), box ``size`` (length, width, height; NaN unknown)
     and ``velocity`` (n, 3) in the box's own frame (x forward; NaN when not given);
     ``message_stamps``: the header stamp of every message of the batch, with objects or not."""
 
     message: np.ndarray
     stamp: np.ndarray
-    frame_id: np.ndarray
-    id: np.ndarray
-    category: np.ndarray
+    frame_id: np.ndarray | Coded
+    id: np.ndarray | Coded
+    category: np.ndarray | Coded
     xyz: np.ndarray
     quat: np.ndarray
     size: np.ndarray

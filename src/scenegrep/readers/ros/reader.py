@@ -1,19 +1,18 @@
 """The ``ros-bag`` format: MCAP files and ROS 2 bag directories read into one label trace.
 
-:func:`iter_chunks` runs the incremental pipeline (:mod:`.framing`) over a bag's messages in
-batches and yields each chunk of completed frames; :func:`read_trace` is that run to the end,
-its chunks concatenated. Options (topics, frame topic or rate, map and ego frames) are a
+:func:`read_traces` runs the incremental pipeline (:mod:`.framing`) over a bag's messages in
+batches to the end: the bag's frames as one trace. Options (topics, frame topic or rate, map and ego frames) are a
 :class:`BagOptions`, by default those in force (:func:`.options.current`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Iterable, Iterator
 from itertools import islice
 from pathlib import Path
 
 from ...errors import UserError, at
-from ...model import LabelTrace, TraceSource, concatenate
+from ...model import LabelTrace, TraceSource
 from .bag import bag_messages
 from .framing import frames
 from .messages import RawMessage
@@ -32,19 +31,12 @@ def batches(messages: Iterable[RawMessage], size: int = BATCH) -> Iterator[list[
         yield batch
 
 
-def iter_chunks(
-    path: str | Path, options: BagOptions | None = None, note: Callable[[str], None] | None = None
-) -> Iterator[LabelTrace]:
-    """The chunks of frames of a bag, as the pipeline completes them."""
-    source = TraceSource(str(path), FORMAT)
-    yield from frames(batches(bag_messages(path, views=True)), options or current(), Path(path).stem, source, note)
-
-
 def read_traces(path: str | Path, options: BagOptions | None = None) -> Iterator[LabelTrace]:
     """The bag's trace, or nothing when it holds no box message to build a frame from."""
-    chunks = list(iter_chunks(path, options))
-    if chunks:
-        yield concatenate(chunks)
+    source = TraceSource(str(path), FORMAT)
+    trace = frames(batches(bag_messages(path, views=True)), options or current(), Path(path).stem, source)
+    if trace is not None:
+        yield trace
 
 
 def read_trace(path: str | Path, options: BagOptions | None = None) -> LabelTrace:

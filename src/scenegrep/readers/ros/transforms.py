@@ -11,6 +11,7 @@ extrapolation: a stamp before a link's first sample or after its last is missing
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -30,26 +31,51 @@ class MissingTransform(LookupError):
         self.reason = reason
 
 
+Components = Sequence[np.ndarray]
+"""A column of quaternions as its components (x, y, z, w), or of vectors as (x, y, z): one array
+each (the hot paths work on contiguous components, not on (n, 4) rows)."""
+
+
+def product(a: Components, b: Components) -> tuple[np.ndarray, ...]:
+    """The components of the Hamilton products a * b of quaternions."""
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    )
+
+
+def rotated(q: Components, v: Components) -> tuple[np.ndarray, ...]:
+    """The components of vectors ``v`` rotated by unit quaternions ``q``: v + 2w (u x v) + u x 2(u x v)
+    for q = (u, w)."""
+    ux, uy, uz, w = q
+    vx, vy, vz = v
+    tx, ty, tz = 2.0 * (uy * vz - uz * vy), 2.0 * (uz * vx - ux * vz), 2.0 * (ux * vy - uy * vx)
+    return vx + w * tx + (uy * tz - uz * ty), vy + w * ty + (uz * tx - ux * tz), vz + w * tz + (ux * ty - uy * tx)
+
+
+def yaw(q: Components) -> np.ndarray:
+    """Rotation about +z of quaternions (radians, counter-clockwise from +x)."""
+    x, y, z, w = q
+    return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
 def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Hamilton products a * b of (n, 4) quaternions (x, y, z, w)."""
-    ax, ay, az, aw = a.T
-    bx, by, bz, bw = b.T
-    return np.stack(
-        [
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-            aw * bw - ax * bx - ay * by - az * bz,
-        ],
-        axis=1,
-    )
+    return np.stack(product(a.T, b.T), axis=1)
 
 
 def quat_rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """(n, 3) vectors ``v`` rotated by unit quaternions ``q`` (n, 4)."""
-    u, w = q[:, :3], q[:, 3:4]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    return np.stack(rotated(q.T, v.T), axis=1)
+
+
+def yaw_of(q: np.ndarray) -> np.ndarray:
+    """Rotation about +z of (n, 4) quaternions (radians, counter-clockwise from +x)."""
+    return yaw(q.T)
 
 
 def normalised(q: np.ndarray) -> np.ndarray:
@@ -71,37 +97,56 @@ def slerp(q0: np.ndarray, q1: np.ndarray, t: np.ndarray) -> np.ndarray:
     return normalised(w0[:, None] * q0 + w1[:, None] * q1)
 
 
-def yaw_of(q: np.ndarray) -> np.ndarray:
-    """Rotation about +z of quaternions (radians, counter-clockwise from +x)."""
-    x, y, z, w = q.T
-    return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 @dataclass
 class _Link:
+    """A link's samples, sorted by stamp with one sample per stamp (the last received), in arrays
+    that grow by appending (their capacity doubles), so adding samples in stamp order costs
+    what they hold, not what the link holds; a sample out of order re-sorts them."""
+
     parent: str
     static: bool
-    pending: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
-    _arrays: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
+    size: int = 0
+    stamps: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
+    values: np.ndarray = field(default_factory=lambda: np.empty((0, 10)))
+    """Per sample: position (3), rotation (4), velocity (3; NaN unknown)."""
 
     def add(self, stamps: np.ndarray, xyz: np.ndarray, quat: np.ndarray, velocity: np.ndarray | None) -> None:
+        stamps = np.asarray(stamps, dtype=np.int64)
+        if not len(stamps):
+            return
         velocity = np.full(xyz.shape, np.nan) if velocity is None else velocity
-        self.pending.append((np.asarray(stamps, dtype=np.int64), xyz, normalised(quat), velocity))
+        values = np.concatenate([xyz, normalised(quat), velocity], axis=1)
+        known = self.stamps[: self.size]
+        if (stamps[1:] >= stamps[:-1]).all() and (not self.size or stamps[0] >= known[-1]):
+            start = self.size - 1 if self.size and stamps[0] == known[-1] else self.size  # it replaces the last
+        else:
+            stamps, values = np.concatenate([known, stamps]), np.concatenate([self.values[: self.size], values])
+            order = np.argsort(stamps, kind="stable")
+            stamps, values = stamps[order], values[order]
+            start = 0
+        last = np.r_[stamps[1:] != stamps[:-1], True]
+        self._put(start, stamps[last], values[last])
+
+    def _put(self, start: int, stamps: np.ndarray, values: np.ndarray) -> None:
+        """Write samples from position ``start`` on (the samples there and after are dropped)."""
+        size = start + len(stamps)
+        if size > len(self.stamps):
+            capacity = max(2 * len(self.stamps), size, 16)
+            grown_stamps, grown_values = np.empty(capacity, dtype=np.int64), np.empty((capacity, 10))
+            grown_stamps[:start], grown_values[:start] = self.stamps[:start], self.values[:start]
+            self.stamps, self.values = grown_stamps, grown_values
+        self.stamps[start:size], self.values[start:size] = stamps, values
+        self.size = size
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Stamps (sorted, one sample per stamp: the last received), positions, rotations,
-        velocities (in the child frame; NaN unknown). Samples added since the last call are
-        merged into the arrays then (no sort when they come in stamp order, as they do)."""
-        if self.pending:
-            parts = ([self._arrays] if self._arrays is not None else []) + self.pending
-            stamps, xyz, quat, velocity = (np.concatenate([p[k] for p in parts]) for k in range(4))
-            if not (stamps[1:] >= stamps[:-1]).all():
-                order = np.argsort(stamps, kind="stable")
-                stamps, xyz, quat, velocity = stamps[order], xyz[order], quat[order], velocity[order]
-            last = np.r_[stamps[1:] != stamps[:-1], True]
-            self._arrays = (stamps[last], xyz[last], quat[last], velocity[last])
-            self.pending = []
-        return self._arrays  # type: ignore[return-value]
+        velocities (in the child frame; NaN unknown): views of the samples held."""
+        values = self.values[: self.size]
+        return self.stamps[: self.size], values[:, :3], values[:, 3:7], values[:, 7:]
+
+    def last(self) -> int:
+        """The stamp of the last sample (ns)."""
+        return int(self.stamps[self.size - 1])
 
     def at(self, stamps: np.ndarray, child: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position, rotation and velocity of the child at each stamp (see the module docstring)."""
@@ -170,7 +215,7 @@ class TfBuffer:
         path = self.chain(frame, target)
         if path is None:
             return None
-        ends = [self.links[c].arrays()[0][-1] for c in path if not self.links[c].static]
+        ends = [self.links[c].last() for c in path if not self.links[c].static]
         return int(min(ends)) if ends else np.iinfo(np.int64).max
 
     def lookup(self, frame: str, target: str, stamps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,127 @@
+"""Framing alone (issue 18): the bag reader's framing stage (:mod:`scenegrep.readers.ros.framing`)
+fed pre-decoded batches, in CPU microseconds per TrackedObjects message.
+
+The bag of ``bench_bag.py --read N`` (N TrackedObjects messages of ``--objects`` objects, one
+``/tf`` message per frame) is read and decoded once, in the offline reader's batches; the
+decoded boxes and links are kept (the messages' bytes are not). Then, ``--runs`` times, a
+:class:`FrameBuilder` is fed the same batches with decoding replaced by a look-up of the kept
+results, into one trace as ``read_trace`` makes it; the CPU time (``time.process_time``) of
+that is the framing time. ``--lifetime L`` gives each object a new
+UUID every L messages (staggered), so the trace has about N * objects / L objects, as a real
+log's tracks come and go (default: the same objects throughout, as bench_bag.py writes).
+``--coded``: the boxes' ids, classes and frame ids come as :class:`Coded` columns (codes into
+names) rather than object arrays. ``--profile`` prints the top of a cProfile of one run.
+
+    python benchmarks/bench_framing.py [--read 10000] [--objects 50] [--lifetime 0] [--coded] [--runs 3] [--profile]
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import dataclasses
+import json
+import os
+import pstats
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "src"))
+sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "benchmarks"))
+
+from bench_bag import write_read_bench  # noqa: E402
+from scenegrep.readers.ros import decoders, framing  # noqa: E402
+from scenegrep.readers.ros.bag import bag_messages  # noqa: E402
+from scenegrep.readers.ros.messages import Boxes, Coded, RawMessage  # noqa: E402
+from scenegrep.readers.ros.options import BagOptions  # noqa: E402
+from scenegrep.readers.ros.reader import batches  # noqa: E402
+
+
+def churned(boxes: Boxes, lifetime: int, start: int) -> Boxes:
+    """``boxes`` (rows in message order, the same count per message) with the k-th object of
+    message m (m counted from ``start``) given a UUID of its slot k and its generation
+    (m + k * lifetime / per message) // lifetime, formatted as the decoder does."""
+    per = len(boxes) // len(boxes.message_stamps)
+    slot = np.arange(len(boxes)) % per
+    generation = (boxes.message + start + slot * lifetime // per) // lifetime
+    raw = np.zeros((len(boxes), 16), dtype=np.uint8)
+    raw[:, :8] = slot.astype("<u8").view(np.uint8).reshape(-1, 8)
+    raw[:, 8:] = generation.astype("<u8").view(np.uint8).reshape(-1, 8)
+    return dataclasses.replace(boxes, id=decoders._uuid_text(raw))
+
+
+def predecode(path: Path, lifetime: int, coded: bool) -> tuple[list[list[RawMessage]], dict]:
+    """The batches (messages without their bytes) and each topic batch's decoded result, keyed by
+    (topic, first log time); ``coded``: the boxes' string columns as :class:`Coded`."""
+    light, cache, start = [], {}, 0
+    for batch in batches(bag_messages(path, views=True)):
+        by_topic: dict[str, list[RawMessage]] = {}
+        for m in batch:
+            by_topic.setdefault(m.topic, []).append(m)
+        for topic, messages in by_topic.items():
+            decoded = decoders.decode_batch(messages)
+            if lifetime and isinstance(decoded, Boxes):
+                decoded = churned(decoded, lifetime, start)
+                start += len(messages)
+            if coded and isinstance(decoded, Boxes):
+                decoded = dataclasses.replace(
+                    decoded, **{c: Coded.of(getattr(decoded, c)) for c in ("id", "category", "frame_id")}
+                )
+            cache[topic, messages[0].log_time] = decoded
+        light.append([m._replace(data=b"") for m in batch])
+    return light, cache
+
+
+def run(light: list[list[RawMessage]], cache: dict) -> tuple[float, object]:
+    """CPU seconds of framing the batches (decoding looked up) into one trace."""
+    framing.decode_batch = lambda messages: cache[messages[0].topic, messages[0].log_time]
+    start = time.process_time()
+    trace = framing.frames(light, BagOptions(), "bench")
+    return time.process_time() - start, trace
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--read", type=int, default=10_000, metavar="N", help="TrackedObjects messages")
+    parser.add_argument("--objects", type=int, default=50)
+    parser.add_argument("--lifetime", type=int, default=0, help="messages an object id lives (0: forever)")
+    parser.add_argument("--coded", action="store_true", help="string columns decoded as Coded")
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--profile", action="store_true")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "bench.mcap"
+        write_read_bench(path, args.read, args.objects)
+        light, cache = predecode(path, args.lifetime, args.coded)
+    times = []
+    for _ in range(args.runs):
+        seconds, trace = run(light, cache)
+        times.append(seconds / args.read * 1e6)
+    assert trace.n_frames == args.read, trace.n_frames
+    report = {
+        "messages": args.read,
+        "objects_per_message": args.objects,
+        "lifetime": args.lifetime,
+        "coded": args.coded,
+        "objects": trace.n_objects,
+        "states": len(trace.states),
+        "load_average": os.getloadavg()[0],
+        "framing_cpu_us_per_message": round(statistics.median(times), 2),
+        "each_run": [round(t, 2) for t in times],
+    }
+    print(json.dumps(report, indent=2))
+    if args.profile:
+        profile = cProfile.Profile()
+        profile.runcall(run, light, cache)
+        pstats.Stats(profile).sort_stats("cumulative").print_stats(35)
+
+
+if __name__ == "__main__":
+    main()

@@ -95,6 +95,7 @@ def main() -> None:
     parser.add_argument("--coded", action="store_true", help="string columns decoded as Coded")
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--profile", action="store_true")
+    parser.add_argument("--sort", default="cumulative", help="the profile's order (cumulative, tottime)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "bench.mcap"
@@ -120,7 +121,7 @@ def main() -> None:
     if args.profile:
         profile = cProfile.Profile()
         profile.runcall(run, light, cache)
-        pstats.Stats(profile).sort_stats("cumulative").print_stats(35)
+        pstats.Stats(profile).sort_stats(args.sort).print_stats(35)
 
 
 if __name__ == "__main__":

@@ -93,17 +93,17 @@ class _Names:
             self.names.append(name)
         return code
 
-    def codes(self, column: np.ndarray | Coded) -> np.ndarray:
-        """The code of every row of a string column."""
+    def codes(self, column: np.ndarray | Coded) -> tuple[np.ndarray, np.ndarray]:
+        """The code of every row of a string column (int32), and the codes of its names."""
         coded = column if isinstance(column, Coded) else Coded.of(column)
-        table = np.fromiter(map(self.code, coded.names.tolist()), dtype=np.int64, count=len(coded.names))
-        return table[coded.codes]
+        table = np.fromiter(map(self.code, coded.names.tolist()), dtype=np.int32, count=len(coded.names))
+        return table[coded.codes], table
 
 
 @dataclass
 class _Segment:
     """The boxes of one decoded batch of one topic, its messages' stamps and log times, and (3-D
-    boxes) the builder's codes of every row's object id, class and frame id."""
+    boxes) the builder's codes (int32) of every row's object id, class and frame id."""
 
     topic: str
     boxes: Boxes | ImageBoxes
@@ -112,6 +112,8 @@ class _Segment:
     ids: np.ndarray | None = None
     classes: np.ndarray | None = None
     frames: np.ndarray | None = None
+    objects: np.ndarray | None = None
+    """The codes of the ids its rows may hold (each once)."""
     alive: np.ndarray = field(init=False)
 
     def __post_init__(self) -> None:
@@ -131,15 +133,19 @@ class _Segment:
 class _Part:
     """The frames one emission completed, before they become a trace: their ``stamps`` (ns),
     ``times`` (s from the origin), and per row (in frame order, topics in pick order, the ego
-    last): its ``frame`` (position among these frames), the builder's ``ids`` and ``classes``
-    codes, and ``values`` (9, n): x, y, z, heading, length, width, height, vx, vy."""
+    last): its ``frame`` (position among these frames) and the builder's code of its object id
+    (``ids``; int32), and ``values`` (9, n): x, y, z, heading, length, width, height, vx, vy. Per
+    object id it holds (``seen``, any order): its ``first`` row and that row's class code
+    (``first_class``)."""
 
     stamps: np.ndarray
     times: np.ndarray
     frame: np.ndarray
     ids: np.ndarray
-    classes: np.ndarray
     values: np.ndarray
+    seen: np.ndarray
+    first: np.ndarray
+    first_class: np.ndarray
     has_ego: bool
     images: ImageLayer | None
 
@@ -173,6 +179,7 @@ class FrameBuilder:
         self.newest = np.iinfo(np.int64).min
         self.ids, self.classes, self.frames = _Names(), _Names(), _Names()
         self.map_code = self.frames.code(options.map_frame)
+        self._scratch = np.empty(0, dtype=np.int64)
 
     # ------------------------------------------------------------------ input
     def feed(self, batch: Sequence[RawMessage]) -> LabelTrace | None:
@@ -248,8 +255,10 @@ class FrameBuilder:
             self.origin = int(boxes.message_stamps.min())
         segment = _Segment(topic, boxes, boxes.message_stamps, log_times)
         if isinstance(boxes, Boxes):
-            segment.ids, segment.classes = self.ids.codes(boxes.id), self.classes.codes(boxes.category)
-            segment.frames = self.frames.codes(boxes.frame_id)
+            segment.ids, objects = self.ids.codes(boxes.id)
+            segment.objects = np.unique(objects)
+            segment.classes, _ = self.classes.codes(boxes.category)
+            segment.frames, _ = self.frames.codes(boxes.frame_id)
         if self.last_stamp is not None:
             late = segment.stamps <= self.last_stamp
             if self.options.rate is not None:
@@ -380,11 +389,11 @@ class FrameBuilder:
         if self.origin is None:
             self.origin = int(stamps[0])
         images = _image_layer([p for p in picks if p[0].frames is None])
-        frame, ids, classes, values = [], [], [], []
+        frame, ids, classes, values, objects = [], [], [], [], []
         for seg, messages, frames in picks:
             if seg.frames is None:
                 continue
-            frame_of = np.full(len(seg.stamps), -1)
+            frame_of = np.full(len(seg.stamps), -1, dtype=np.int32)
             frame_of[messages] = frames
             rows = seg.rows(messages)
             if isinstance(rows, np.ndarray) and not rows.any():
@@ -393,23 +402,46 @@ class FrameBuilder:
             ids.append(seg.ids[rows])  # type: ignore[index]
             classes.append(seg.classes[rows])  # type: ignore[index]
             values.append(self._values(seg, rows))
+            objects.append(seg.objects)
         ego = self._ego(stamps)
         if ego is not None:
-            frame.append(np.arange(len(stamps)))
-            ids.append(np.full(len(stamps), self.ids.code(EGO_ID)))
-            classes.append(np.full(len(stamps), self.classes.code(EGO_ID)))
+            frame.append(np.arange(len(stamps), dtype=np.int32))
+            ids.append(np.full(len(stamps), self.ids.code(EGO_ID), dtype=np.int32))
+            classes.append(np.full(len(stamps), self.classes.code(EGO_ID), dtype=np.int32))
             values.append(ego)
-        frame_all = np.concatenate(frame) if frame else np.empty(0, np.int64)
-        ids_all = np.concatenate(ids) if ids else np.empty(0, np.int64)
-        classes_all = np.concatenate(classes) if classes else np.empty(0, np.int64)
+            objects.append(ids[-1][:1])
+        frame_all, ids_all, classes_all = (
+            np.concatenate(c) if c else np.empty(0, np.int32) for c in (frame, ids, classes)
+        )
         values_all = _columns(values)
         if not (frame_all[1:] >= frame_all[:-1]).all():
             by_frame = np.argsort(frame_all, kind="stable")
             frame_all, ids_all, classes_all = frame_all[by_frame], ids_all[by_frame], classes_all[by_frame]
             values_all = np.take(values_all, by_frame, axis=1)
+        seen, first = self._first_rows(ids_all, np.unique(np.concatenate(objects)) if objects else ids_all)
         return _Part(
-            stamps, (stamps - self.origin) / 1e9, frame_all, ids_all, classes_all, values_all, ego is not None, images
+            stamps,
+            (stamps - self.origin) / 1e9,
+            frame_all,
+            ids_all,
+            values_all,
+            seen,
+            first,
+            classes_all[first],
+            ego is not None,
+            images,
         )
+
+    def _first_rows(self, ids: np.ndarray, candidates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The codes among ``candidates`` that ``ids`` holds, and the first row of each (no sort:
+        a minimum per code in a table of every code, reset only where ``candidates`` are)."""
+        if len(self._scratch) < len(self.ids):
+            self._scratch = np.empty(2 * len(self.ids), dtype=np.int64)
+        self._scratch[candidates] = len(ids)
+        np.minimum.at(self._scratch, ids, np.arange(len(ids)))
+        first = self._scratch[candidates]
+        present = first < len(ids)
+        return candidates[present], first[present]
 
     def _values(self, seg: _Segment, rows: np.ndarray | slice) -> np.ndarray:
         """The (9, n) state values of ``rows`` of a segment's boxes (:class:`_Part`): each box moved
@@ -424,12 +456,14 @@ class FrameBuilder:
             group = slice(None) if len(present) == 1 else np.flatnonzero(codes == code)
             position, rotation = tuple(xyz[group].T), tuple(quat[group].T)
             if code != self.map_code:
-                t, q = self._transforms(seg, rows, group, code)
-                position = tuple(p + s for p, s in zip(rotated(q, position), t))
-                rotation = product(q, rotation)
+                shift, turn = self._transforms(seg, rows, group, code)
+                position = rotated(turn, position)
+                for moved, by in zip(position, shift):
+                    moved += by
+                rotation = product(turn, rotation)
             out[0, group], out[1, group], out[2, group] = position
             out[3, group] = heading_from_yaw(yaw(rotation))
-            out[7, group], out[8, group], _ = rotated(rotation, tuple(velocity[group].T))
+            out[7, group], out[8, group] = rotated(rotation, tuple(velocity[group].T), axes=2)
         return out
 
     def _transforms(
@@ -437,7 +471,8 @@ class FrameBuilder:
     ) -> tuple[list[np.ndarray], list[np.ndarray]]:
         """The translation and rotation components (:data:`.transforms.Components`) of frame id
         ``code`` in the map frame at the stamp of each box of ``group`` of ``rows`` (one lookup per
-        distinct stamp; a stamp without a transform is a :class:`UserError` naming the box's message)."""
+        distinct stamp; a stamp without a transform is a :class:`UserError` naming the first
+        box's message without one)."""
         boxes: Boxes = seg.boxes  # type: ignore[assignment]
         stamps = boxes.stamp[rows][group]
         distinct, each = _distinct(stamps)
@@ -481,21 +516,28 @@ class FrameBuilder:
         """One trace of consecutive parts, the first of them emitted as frame ``self.emitted``:
         objects numbered in order of first appearance, each with its class there; of the rows
         of one object in one frame the first is kept."""
-        offsets = np.cumsum([0] + [len(p.stamps) for p in parts])
-        frame = np.concatenate([p.frame + offset for p, offset in zip(parts, offsets)])
-        ids = np.concatenate([p.ids for p in parts])
-        classes = np.concatenate([p.classes for p in parts])
-        values = _columns([p.values for p in parts])
-        n = len(frame)
-        first = np.full(len(self.ids), n, dtype=np.int64)  # rows are in frame order
-        np.minimum.at(first, ids, np.arange(n))
+        offsets = np.cumsum([0] + [len(p.stamps) for p in parts]).tolist()
+        starts = np.cumsum([0] + [len(p.frame) for p in parts]).tolist()
+        n = starts[-1]
+        first, category = np.full(len(self.ids), n, dtype=np.int64), np.zeros(len(self.ids), dtype=np.int64)
+        for p, start in zip(parts, starts):  # (parts in frame order: an object's first part is the earliest)
+            new = first[p.seen] == n
+            first[p.seen[new]], category[p.seen[new]] = p.first[new] + start, p.first_class[new]
         seen = np.flatnonzero(first < n)
         objects = seen[np.argsort(first[seen], kind="stable")]
-        number = np.empty(len(self.ids), dtype=np.int64)
-        number[objects] = np.arange(len(objects))
-        obj = number[ids]
-        key = frame * max(len(objects), 1) + obj
-        if not (key[1:] > key[:-1]).all():  # an object twice in a frame, or objects out of order
+        number = np.zeros(len(self.ids), dtype=np.int32)
+        number[objects] = np.arange(len(objects), dtype=np.int32)
+        frame, obj, values = np.empty(n, dtype=np.int32), np.empty(n, dtype=np.int32), np.empty((9, n))
+        ordered = True  # by (frame, object) without repeats, part by part (parts follow each other)
+        for p, start, offset in zip(parts, starts, offsets):
+            rows = slice(start, start + len(p.frame))
+            np.add(p.frame, offset, out=frame[rows])
+            np.take(number, p.ids, out=obj[rows])
+            values[:, rows] = p.values
+            key = frame[rows].astype(np.int64) * max(len(objects), 1) + obj[rows]
+            ordered = ordered and bool((key[1:] > key[:-1]).all())
+        if not ordered:  # an object twice in a frame, or objects out of order
+            key = frame.astype(np.int64) * max(len(objects), 1) + obj
             order = np.argsort(key, kind="stable")
             keep = order[np.r_[True, key[order][1:] != key[order][:-1]]] if n else order
             frame, obj, values = frame[keep], obj[keep], np.take(values, keep, axis=1)
@@ -505,16 +547,16 @@ class FrameBuilder:
         )
         names, class_names = self.ids.names, self.classes.names
         objects_table = ObjectTable.build(
-            [names[k] for k in objects.tolist()], [str(class_names[c]) for c in classes[first[objects]].tolist()]
+            [names[k] for k in objects.tolist()], [str(class_names[c]) for c in category[objects].tolist()]
         )
         images = (
             parts[0].images
             if len(parts) == 1
-            else concatenate_layers([(p.images, int(o), np.empty(0, np.int32)) for p, o in zip(parts, offsets)])
+            else concatenate_layers([(p.images, o, np.empty(0, np.int32)) for p, o in zip(parts, offsets)])
         )
         trace = LabelTrace.build(
             self.name,
-            np.arange(self.emitted, self.emitted + int(offsets[-1])),
+            np.arange(self.emitted, self.emitted + offsets[-1]),
             np.concatenate([p.times for p in parts]),
             objects_table,
             states,
@@ -523,7 +565,7 @@ class FrameBuilder:
             attributes={"dataset": "ros2-bag", "time_origin_ns": self.origin, **self._ego_size_note()},
             source=self.source,
         )
-        self.emitted += int(offsets[-1])
+        self.emitted += offsets[-1]
         return trace
 
 

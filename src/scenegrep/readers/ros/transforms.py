@@ -36,31 +36,56 @@ Components = Sequence[np.ndarray]
 each (the hot paths work on contiguous components, not on (n, 4) rows)."""
 
 
+def _sum(*terms: tuple[np.ndarray, np.ndarray, int]) -> np.ndarray:
+    """p0 q0 ± p1 q1 ± ... of terms (p, q, sign), added from the left in place (the same bits as
+    the plain expression, without a new array per operation)."""
+    (p, q, _), *rest = terms
+    out, scratch = np.multiply(p, q), np.empty(np.shape(p))
+    for p, q, sign in rest:
+        (np.add if sign > 0 else np.subtract)(out, np.multiply(p, q, out=scratch), out=out)
+    return out
+
+
 def product(a: Components, b: Components) -> tuple[np.ndarray, ...]:
     """The components of the Hamilton products a * b of quaternions."""
     ax, ay, az, aw = a
     bx, by, bz, bw = b
     return (
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
+        _sum((aw, bx, 1), (ax, bw, 1), (ay, bz, 1), (az, by, -1)),
+        _sum((aw, by, 1), (ax, bz, -1), (ay, bw, 1), (az, bx, 1)),
+        _sum((aw, bz, 1), (ax, by, 1), (ay, bx, -1), (az, bw, 1)),
+        _sum((aw, bw, 1), (ax, bx, -1), (ay, by, -1), (az, bz, -1)),
     )
 
 
-def rotated(q: Components, v: Components) -> tuple[np.ndarray, ...]:
-    """The components of vectors ``v`` rotated by unit quaternions ``q``: v + 2w (u x v) + u x 2(u x v)
-    for q = (u, w)."""
+def rotated(q: Components, v: Components, axes: int = 3) -> tuple[np.ndarray, ...]:
+    """The components of vectors ``v`` rotated by unit quaternions ``q``: v + w t + u x t with
+    t = 2 (u x v), for q = (u, w); the first ``axes`` of them (x, y, z)."""
     ux, uy, uz, w = q
     vx, vy, vz = v
-    tx, ty, tz = 2.0 * (uy * vz - uz * vy), 2.0 * (uz * vx - ux * vz), 2.0 * (ux * vy - uy * vx)
-    return vx + w * tx + (uy * tz - uz * ty), vy + w * ty + (uz * tx - ux * tz), vz + w * tz + (ux * ty - uy * tx)
+    tx, ty, tz = _sum((uy, vz, 1), (uz, vy, -1)), _sum((uz, vx, 1), (ux, vz, -1)), _sum((ux, vy, 1), (uy, vx, -1))
+    for t in (tx, ty, tz):
+        t *= 2.0
+    out = []
+    for value, along, cross in (
+        (vx, tx, ((uy, tz, 1), (uz, ty, -1))),
+        (vy, ty, ((uz, tx, 1), (ux, tz, -1))),
+        (vz, tz, ((ux, ty, 1), (uy, tx, -1))),
+    )[:axes]:
+        moved = np.multiply(w, along)
+        moved += value
+        moved += _sum(*cross)
+        out.append(moved)
+    return tuple(out)
 
 
 def yaw(q: Components) -> np.ndarray:
     """Rotation about +z of quaternions (radians, counter-clockwise from +x)."""
     x, y, z, w = q
-    return np.arctan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+    sine, cosine = _sum((w, z, 1), (x, y, 1)), _sum((y, y, 1), (z, z, 1))
+    sine *= 2.0
+    cosine *= 2.0
+    return np.arctan2(sine, np.subtract(1.0, cosine, out=cosine), out=sine)
 
 
 def quat_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -109,11 +134,14 @@ class _Link:
     stamps: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
     values: np.ndarray = field(default_factory=lambda: np.empty((0, 10)))
     """Per sample: position (3), rotation (4), velocity (3; NaN unknown)."""
+    moving: bool = False
+    """Whether any sample came with a velocity (an odometry twist)."""
 
     def add(self, stamps: np.ndarray, xyz: np.ndarray, quat: np.ndarray, velocity: np.ndarray | None) -> None:
         stamps = np.asarray(stamps, dtype=np.int64)
         if not len(stamps):
             return
+        self.moving |= velocity is not None
         velocity = np.full(xyz.shape, np.nan) if velocity is None else velocity
         values = np.concatenate([xyz, normalised(quat), velocity], axis=1)
         known = self.stamps[: self.size]
@@ -148,11 +176,32 @@ class _Link:
         """The stamp of the last sample (ns)."""
         return int(self.stamps[self.size - 1])
 
-    def at(self, stamps: np.ndarray, child: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Position, rotation and velocity of the child at each stamp (see the module docstring)."""
-        known, xyz, quat, velocity = self.arrays()
+    def at(self, stamps: np.ndarray, child: str) -> tuple[np.ndarray, np.ndarray]:
+        """Position and rotation of the child at each stamp (see the module docstring)."""
+        known, xyz, quat, _ = self.arrays()
         if self.static:
-            return tuple(np.repeat(c[-1:], len(stamps), axis=0) for c in (xyz, quat, velocity))  # type: ignore[return-value]
+            return np.repeat(xyz[-1:], len(stamps), axis=0), np.repeat(quat[-1:], len(stamps), axis=0)
+        lower, upper, t, exact = self._between(stamps, child)
+        if len(known) == 1:
+            return xyz[lower], quat[lower]
+        return _linear(xyz, lower, upper, t, exact), np.where(
+            exact[:, None], quat[upper], slerp(quat[lower], quat[upper], t)
+        )
+
+    def velocity_at(self, stamps: np.ndarray, child: str) -> np.ndarray:
+        """The child's velocity (its own axes; NaN unknown) at each stamp, interpolated linearly."""
+        known, _, _, velocity = self.arrays()
+        if self.static:
+            return np.repeat(velocity[-1:], len(stamps), axis=0)
+        lower, upper, t, exact = self._between(stamps, child)
+        if len(known) == 1 or not self.moving:  # (NaN everywhere without odometry)
+            return velocity[lower]
+        return _linear(velocity, lower, upper, t, exact)
+
+    def _between(self, stamps: np.ndarray, child: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Per stamp: the samples before and after it, its fraction of the way and whether it is
+        the later sample's stamp; MissingTransform outside the samples."""
+        known = self.stamps[: self.size]
         outside = (stamps < known[0]) | (stamps > known[-1])
         if outside.any():
             row = int(np.argmax(outside))
@@ -163,18 +212,19 @@ class _Link:
             )
         upper = np.clip(np.searchsorted(known, stamps, side="left"), 1, max(len(known) - 1, 1))
         lower = upper - 1
-        if len(known) == 1:
-            return xyz[lower], quat[lower], velocity[lower]
+        if len(known) == 1:  # (the stamps are that sample's)
+            return lower, lower, np.ones(len(stamps)), np.ones(len(stamps), dtype=bool)
         span = (known[upper] - known[lower]).astype(np.float64)
         t = np.clip((stamps - known[lower]) / span, 0.0, 1.0)
         exact = stamps == known[upper]
-        t = np.where(exact, 1.0, t)
+        return lower, upper, np.where(exact, 1.0, t), exact
 
-        def linear(values: np.ndarray) -> np.ndarray:
-            between = values[lower] + t[:, None] * (values[upper] - values[lower])
-            return np.where(exact[:, None], values[upper], between)
 
-        return linear(xyz), np.where(exact[:, None], quat[upper], slerp(quat[lower], quat[upper], t)), linear(velocity)
+def _linear(values: np.ndarray, lower: np.ndarray, upper: np.ndarray, t: np.ndarray, exact: np.ndarray) -> np.ndarray:
+    """Samples' ``values`` interpolated linearly between ``lower`` and ``upper`` at fractions ``t``
+    (the ``upper`` sample's values exactly where ``exact``)."""
+    between = values[lower] + t[:, None] * (values[upper] - values[lower])
+    return np.where(exact[:, None], values[upper], between)
 
 
 class TfBuffer:
@@ -182,11 +232,14 @@ class TfBuffer:
 
     def __init__(self) -> None:
         self.links: dict[str, _Link] = {}
+        self._last: tuple | None = None
+        """The last lookup: its frames, stamps and result (until links are added)."""
 
     def add(self, links: Transforms, static: bool = False) -> None:
         """Add the samples of ``links`` (``static``: they hold at every stamp)."""
         if not len(links):
             return
+        self._last = None
         for child in dict.fromkeys(links.child.tolist()):
             rows = np.flatnonzero(links.child == child)
             parent = str(links.parent[rows[-1]])
@@ -220,17 +273,23 @@ class TfBuffer:
 
     def lookup(self, frame: str, target: str, stamps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Position (n, 3) and rotation (n, 4) of ``frame`` in ``target`` at each stamp (ns);
-        MissingTransform when there is no chain or a link is unknown at a stamp."""
+        MissingTransform when there is no chain or a link is unknown at a stamp. The same lookup
+        again (the boxes of a frame in the ego's frame, then the ego, at the same stamps) gives
+        the same arrays, not computed again: callers do not modify them."""
         stamps = np.asarray(stamps, dtype=np.int64)
+        last = self._last
+        if last is not None and last[:2] == (frame, target) and np.array_equal(last[2], stamps):
+            return last[3]
         path = self.chain(frame, target)
         if path is None:
             raise MissingTransform(0, f"no transform chain from frame {frame!r} to {target!r}")
         xyz = np.zeros((len(stamps), 3))
         quat = np.tile([0.0, 0.0, 0.0, 1.0], (len(stamps), 1))
         for child in path:
-            link_xyz, link_quat, _ = self.links[child].at(stamps, child)
+            link_xyz, link_quat = self.links[child].at(stamps, child)
             xyz = quat_rotate(link_quat, xyz) + link_xyz
             quat = quat_multiply(link_quat, quat)
+        self._last = (frame, target, stamps, (xyz, quat))
         return xyz, quat
 
     def velocity(self, frame: str, target: str, stamps: np.ndarray, rotation: np.ndarray) -> np.ndarray:
@@ -241,5 +300,4 @@ class TfBuffer:
         link = self.links.get(frame)
         if link is None or frame == target:
             return np.full((len(stamps), 3), np.nan)
-        _, _, own = link.at(np.asarray(stamps, dtype=np.int64), frame)
-        return quat_rotate(rotation, own)
+        return quat_rotate(rotation, link.velocity_at(np.asarray(stamps, dtype=np.int64), frame))

@@ -77,11 +77,11 @@ def test_a_link_keeps_the_last_sample_received_per_stamp_however_it_is_fed(batch
         link.add(np.array(stamps, dtype=np.int64), xyz, np.tile([0.0, 0.0, 0.0, 1.0], (len(stamps), 1)), None)
         received += stamps
         if k < len(reads) and reads[k] and received:
-            link.arrays()  # merged between batches, or not
+            assert link.last() == max(received)  # read between batches, or not
     if not received:
         return
     stamps, xyz, _, velocity = link.arrays()
     last = {stamp: i for i, stamp in enumerate(received)}
-    assert stamps.tolist() == sorted(last)
+    assert stamps.tolist() == sorted(last) and link.last() == max(received)
     assert xyz[:, 0].tolist() == [last[s] for s in sorted(last)]
     assert np.isnan(velocity).all()

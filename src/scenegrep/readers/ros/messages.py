@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..mcap_records import RawMessage
+from .factorize import by_object
 
 __all__ = ["Boxes", "Coded", "DecodeError", "RawMessage", "Transforms"]
 
@@ -40,12 +41,11 @@ class Coded:
     @classmethod
     def of(cls, strings: np.ndarray) -> Coded:
         """The column of an object array of strings; the rows that hold one string object share a
-        code, so the Python work is per distinct object, not per row (a decoder that repeats one
-        object per distinct value gives each value one name)."""
+        code (:func:`.factorize.by_object`), so the Python work is per distinct object, not per row
+        (a decoder that repeats one object per distinct value gives each value one name)."""
         strings = np.asarray(strings, dtype=object)
-        objects = np.fromiter(map(id, strings), dtype=np.int64, count=len(strings))
-        _, first, codes = np.unique(objects, return_index=True, return_inverse=True)
-        return cls(codes.ravel(), strings[first])
+        codes, first = by_object(strings)
+        return cls(codes, strings[first])
 
     def __len__(self) -> int:
         return len(self.codes)

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from mcap_ros2._dynamic import serialize_dynamic
 
 from scenegrep.readers.ros.decoders import AUTOWARE_LABELS, decode_batch
-from scenegrep.readers.ros.messages import RawMessage
+from scenegrep.readers.ros.messages import Coded, RawMessage
 
 from scenegrep.writers.ros_messages import COVARIANCE, ZERO, schema
 
@@ -67,15 +67,19 @@ def test_decoded_values_are_the_encoded_ones(messages):
         for i, (objects, frame) in enumerate(messages)
     ]
     boxes = decode_batch(raw)
+    frame_ids, ids, categories = (
+        column.strings() if isinstance(column, Coded) else column
+        for column in (boxes.frame_id, boxes.id, boxes.category)
+    )
     expected = [(i, o, frame) for i, (objects, frame) in enumerate(messages) for o in objects]
     assert len(boxes) == len(expected)
     np.testing.assert_array_equal(boxes.message_stamps, [(100 + i) * 10**9 + 7 for i in range(len(messages))])
     for row, (i, o, frame) in enumerate(expected):
-        assert boxes.message[row] == i and boxes.frame_id[row] == frame.lstrip("/")
+        assert boxes.message[row] == i and frame_ids[row] == frame.lstrip("/")
         np.testing.assert_array_equal(boxes.xyz[row], o["xyz"])
         np.testing.assert_allclose(boxes.size[row], o["size"])
-        assert boxes.id[row] == str(uuid.UUID(bytes=o["uuid"]))
+        assert ids[row] == str(uuid.UUID(bytes=o["uuid"]))
         best = max(o["classes"], key=lambda c: c[1], default=(0, 0.0))
         ties = [label for label, p in o["classes"] if p == best[1]]
         label = ties[0] if o["classes"] else 0
-        assert boxes.category[row] == (AUTOWARE_LABELS[label] if label < len(AUTOWARE_LABELS) else "UNKNOWN")
+        assert categories[row] == (AUTOWARE_LABELS[label] if label < len(AUTOWARE_LABELS) else "UNKNOWN")

@@ -37,7 +37,7 @@ from .cdr import Level, Payloads, decode
 from .cdr_layout import Layout, decode_same_layout
 from .cdr_walk import Program, Unsupported, decode_walked, program
 from .foxglove import SCENE_UPDATE, decode_scene_updates
-from .messages import Boxes, ImageBoxes, RawMessage, Transforms
+from .messages import Boxes, Coded, ImageBoxes, RawMessage, Transforms
 from .msgdef import Field, normalise, parse_schema
 
 AUTOWARE_LABELS = (
@@ -55,6 +55,7 @@ AUTOWARE_LABELS = (
     "UNDER_DRIVABLE",
 )
 """Autoware's ``ObjectClassification`` labels by value; a value past them reads as UNKNOWN."""
+_LABELS = np.array(AUTOWARE_LABELS, dtype=object)
 
 _POSE = "kinematics.pose_with_covariance.pose."
 _TWIST = "kinematics.twist_with_covariance.twist.linear."
@@ -139,8 +140,8 @@ def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:
     return size
 
 
-def _uuid_text(raw: np.ndarray) -> np.ndarray:
-    """Canonical UUID strings of (n, 16) bytes (formatted once per distinct UUID)."""
+def _uuid_text(raw: np.ndarray) -> Coded:
+    """Canonical UUID strings of (n, 16) bytes, as codes into the distinct ones (each formatted once)."""
     words = np.ascontiguousarray(raw, dtype=np.uint8).view("<u8").reshape(len(raw), 2)
     # sorted by one key per UUID (a mix of its two words), or by both words when two UUIDs share a key
     key = words[:, 0] ^ (words[:, 1] * np.uint64(0x9E3779B97F4A7C15))
@@ -158,9 +159,9 @@ def _uuid_text(raw: np.ndarray) -> np.ndarray:
     for value in raw[order[new]]:
         h = bytes(value).hex()
         texts.append(f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:]}")
-    out = np.empty(len(texts), dtype=object)
-    out[:] = texts
-    return out[inverse]
+    names = np.empty(len(texts), dtype=object)
+    names[:] = texts
+    return Coded(inverse, names)
 
 
 def _autoware(tracked: bool) -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:
@@ -190,9 +191,9 @@ def _autoware(tracked: bool) -> tuple[frozenset[str], Callable[[dict[str, Level]
         return Boxes(
             message,
             stamps[message],
-            frames[message],
+            Coded(message, frames),
             ids,
-            np.array(AUTOWARE_LABELS, dtype=object)[label],
+            Coded(label, _LABELS),
             _vector(f, _POSE + "position.", _XYZ, rows),
             _vector(f, _POSE + "orientation.", "xyzw", rows),
             _shape_size(f, rows),

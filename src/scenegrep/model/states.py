@@ -61,10 +61,19 @@ class StateTable(RowTable):
 
     def sort_order(self) -> np.ndarray | None:
         """The permutation that orders rows by (frame, object), or None when already ordered."""
-        key = self.frame.astype(np.int64) * (int(self.object.max(initial=0)) + 1) + self.object
+        key = self.row_keys(int(self.object.max(initial=0)) + 1)
         if len(key) < 2 or bool(np.all(key[1:] > key[:-1])):
             return None
         return np.argsort(key, kind="stable")
+
+    def row_keys(self, objects: int) -> np.ndarray:
+        """``frame * objects + object`` of every row as int64 (increasing along the rows exactly when
+        they are in (frame, object) order without repeats, for ``objects`` above every object code);
+        made in one array (the table may have millions of rows)."""
+        key = self.frame.astype(np.int64)
+        key *= objects
+        key += self.object
+        return key
 
     def speed(self) -> np.ndarray:
         """Speed in m/s from the velocity columns (NaN where unknown)."""

@@ -131,7 +131,7 @@ class LabelTrace:
             raise ValueError("state object out of range")
         if len(s) and (s.lane.min() < -1 or s.lane.max() >= len(self.lane_ids)):
             raise ValueError("state lane code out of range")
-        key = s.frame.astype(np.int64) * max(self.n_objects, 1) + s.object
+        key = s.row_keys(max(self.n_objects, 1))
         if np.any(key[1:] <= key[:-1]):
             raise ValueError("states must be sorted by (frame, object) without duplicates")
         if self.behaviours is not None and len(self.behaviours) != len(s):

@@ -389,7 +389,7 @@ class FrameBuilder:
         if self.origin is None:
             self.origin = int(stamps[0])
         images = _image_layer([p for p in picks if p[0].frames is None])
-        frame, ids, classes, values, objects = [], [], [], [], []
+        frame, ids, classes, objects, taken = [], [], [], [], []
         for seg, messages, frames in picks:
             if seg.frames is None:
                 continue
@@ -401,19 +401,24 @@ class FrameBuilder:
             frame.append(frame_of[seg.boxes.message[rows]])
             ids.append(seg.ids[rows])  # type: ignore[index]
             classes.append(seg.classes[rows])  # type: ignore[index]
-            values.append(self._values(seg, rows))
             objects.append(seg.objects)
+            taken.append((seg, rows))
+        values_all, start = np.empty((9, sum(map(len, frame)) + len(stamps))), 0
+        for (seg, rows), rows_frame in zip(taken, frame):  # (the boxes first: their errors come first)
+            self._values(seg, rows, values_all[:, start : start + len(rows_frame)])
+            start += len(rows_frame)
         ego = self._ego(stamps)
         if ego is not None:
             frame.append(np.arange(len(stamps), dtype=np.int32))
             ids.append(np.full(len(stamps), self.ids.code(EGO_ID), dtype=np.int32))
             classes.append(np.full(len(stamps), self.classes.code(EGO_ID), dtype=np.int32))
-            values.append(ego)
             objects.append(ids[-1][:1])
+            values_all[:, start:] = ego
+        else:
+            values_all = values_all[:, :start]
         frame_all, ids_all, classes_all = (
             np.concatenate(c) if c else np.empty(0, np.int32) for c in (frame, ids, classes)
         )
-        values_all = _columns(values)
         if not (frame_all[1:] >= frame_all[:-1]).all():
             by_frame = np.argsort(frame_all, kind="stable")
             frame_all, ids_all, classes_all = frame_all[by_frame], ids_all[by_frame], classes_all[by_frame]
@@ -443,13 +448,12 @@ class FrameBuilder:
         present = first < len(ids)
         return candidates[present], first[present]
 
-    def _values(self, seg: _Segment, rows: np.ndarray | slice) -> np.ndarray:
-        """The (9, n) state values of ``rows`` of a segment's boxes (:class:`_Part`): each box moved
-        into the map frame with the transform of its frame id at its stamp, its heading the yaw of
-        its rotation there, its velocity turned by that rotation."""
+    def _values(self, seg: _Segment, rows: np.ndarray | slice, out: np.ndarray) -> None:
+        """The (9, n) state values of ``rows`` of a segment's boxes (:class:`_Part`), written into
+        ``out``: each box moved into the map frame with the transform of its frame id at its stamp,
+        its heading the yaw of its rotation there, its velocity turned by that rotation."""
         boxes: Boxes = seg.boxes  # type: ignore[assignment]
         xyz, quat, velocity, codes = boxes.xyz[rows], boxes.quat[rows], boxes.velocity[rows], seg.frames[rows]  # type: ignore[index]
-        out = np.empty((9, len(codes)))
         out[4:7] = boxes.size[rows].T
         present = np.flatnonzero(np.bincount(codes, minlength=1)).tolist()
         for code in present:
@@ -464,7 +468,6 @@ class FrameBuilder:
             out[0, group], out[1, group], out[2, group] = position
             out[3, group] = heading_from_yaw(yaw(rotation))
             out[7, group], out[8, group] = rotated(rotation, tuple(velocity[group].T), axes=2)
-        return out
 
     def _transforms(
         self, seg: _Segment, rows: np.ndarray | slice, group: np.ndarray | slice, code: int
@@ -542,8 +545,9 @@ class FrameBuilder:
             keep = order[np.r_[True, key[order][1:] != key[order][:-1]]] if n else order
             frame, obj, values = frame[keep], obj[keep], np.take(values, keep, axis=1)
         x, y, z, heading, length, width, height, vx, vy = values
+        lane = np.full(len(frame), -1, dtype=np.int32)
         states = StateTable.build(
-            frame, obj, x, y, heading, z=z, length=length, width=width, height=height, vx=vx, vy=vy
+            frame, obj, x, y, heading, z=z, length=length, width=width, height=height, vx=vx, vy=vy, lane=lane
         )
         names, class_names = self.ids.names, self.classes.names
         objects_table = ObjectTable.build(
@@ -632,12 +636,6 @@ def _by_topic(chosen: list[tuple[_Segment, np.ndarray, np.ndarray]]) -> dict[str
     for item in chosen:
         out.setdefault(item[0].topic, []).append(item)
     return out
-
-
-def _columns(parts: list[np.ndarray]) -> np.ndarray:
-    """(9, n) value arrays side by side, as one C-ordered array (its rows are the state columns)."""
-    out = np.empty((9, sum(p.shape[1] for p in parts)))
-    return np.concatenate(parts, axis=1, out=out) if parts else out
 
 
 def _distinct(stamps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

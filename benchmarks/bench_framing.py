@@ -10,7 +10,7 @@ that is the framing time. ``--lifetime L`` gives each object a new
 UUID every L messages (staggered), so the trace has about N * objects / L objects, as a real
 log's tracks come and go (default: the same objects throughout, as bench_bag.py writes).
 ``--coded``: the boxes' ids, classes and frame ids come as :class:`Coded` columns (codes into
-names) rather than object arrays. ``--profile`` prints the top of a cProfile of one run.
+names) even where the decoder gives object arrays. ``--profile`` prints the top of a cProfile of one run.
 
     python benchmarks/bench_framing.py [--read 10000] [--objects 50] [--lifetime 0] [--coded] [--runs 3] [--profile]
 """
@@ -71,8 +71,9 @@ def predecode(path: Path, lifetime: int, coded: bool) -> tuple[list[list[RawMess
                 decoded = churned(decoded, lifetime, start)
                 start += len(messages)
             if coded and isinstance(decoded, Boxes):
+                columns = {c: getattr(decoded, c) for c in ("id", "category", "frame_id")}
                 decoded = dataclasses.replace(
-                    decoded, **{c: Coded.of(getattr(decoded, c)) for c in ("id", "category", "frame_id")}
+                    decoded, **{c: v if isinstance(v, Coded) else Coded.of(v) for c, v in columns.items()}
                 )
             cache[topic, messages[0].log_time] = decoded
         light.append([m._replace(data=b"") for m in batch])

@@ -531,19 +531,19 @@ class FrameBuilder:
         number = np.zeros(len(self.ids), dtype=np.int32)
         number[objects] = np.arange(len(objects), dtype=np.int32)
         frame, obj, values = np.empty(n, dtype=np.int32), np.empty(n, dtype=np.int32), np.empty((9, n))
-        ordered = True  # by (frame, object) without repeats, part by part (parts follow each other)
-        for p, start, offset in zip(parts, starts, offsets):
-            rows = slice(start, start + len(p.frame))
-            np.add(p.frame, offset, out=frame[rows])
-            np.take(number, p.ids, out=obj[rows])
-            values[:, rows] = p.values
-            key = frame[rows].astype(np.int64) * max(len(objects), 1) + obj[rows]
-            ordered = ordered and bool((key[1:] > key[:-1]).all())
-        if not ordered:  # an object twice in a frame, or objects out of order
-            key = frame.astype(np.int64) * max(len(objects), 1) + obj
-            order = np.argsort(key, kind="stable")
-            keep = order[np.r_[True, key[order][1:] != key[order][:-1]]] if n else order
-            frame, obj, values = frame[keep], obj[keep], np.take(values, keep, axis=1)
+        end = 0
+        for p, offset in zip(parts, offsets):  # (parts hold consecutive frames: each is ordered alone)
+            numbers, frames, part_values = number[p.ids], p.frame, p.values
+            key = frames.astype(np.int64) * max(len(objects), 1) + numbers
+            if not (key[1:] > key[:-1]).all():  # an object twice in a frame, or objects out of order
+                order = np.argsort(key, kind="stable")
+                keep = order[np.r_[True, key[order][1:] != key[order][:-1]]]
+                numbers, frames, part_values = numbers[keep], frames[keep], np.take(part_values, keep, axis=1)
+            rows = slice(end, end + len(numbers))
+            np.add(frames, offset, out=frame[rows])
+            obj[rows], values[:, rows] = numbers, part_values
+            end = rows.stop
+        frame, obj, values = frame[:end], obj[:end], values[:, :end]
         x, y, z, heading, length, width, height, vx, vy = values
         lane = np.full(len(frame), -1, dtype=np.int32)
         states = StateTable.build(

@@ -184,6 +184,8 @@ class _Link:
         lower, upper, t, exact = self._between(stamps, child)
         if len(known) == 1:
             return xyz[lower], quat[lower]
+        if exact.all():  # every stamp a sample's (nothing to interpolate)
+            return xyz[upper], quat[upper]
         return _linear(xyz, lower, upper, t, exact), np.where(
             exact[:, None], quat[upper], slerp(quat[lower], quat[upper], t)
         )
@@ -298,6 +300,6 @@ class TfBuffer:
         in ``target``, from :meth:`lookup`); NaN where its link gives none. The links above it are
         taken as still (an odometry frame's drift is not added)."""
         link = self.links.get(frame)
-        if link is None or frame == target:
+        if link is None or frame == target or not link.moving:
             return np.full((len(stamps), 3), np.nan)
         return quat_rotate(rotation, link.velocity_at(np.asarray(stamps, dtype=np.int64), frame))

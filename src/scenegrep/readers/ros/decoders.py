@@ -36,6 +36,7 @@ import numpy as np
 from .cdr import Level, Payloads, decode
 from .cdr_layout import Layout, decode_same_layout
 from .cdr_walk import Program, Unsupported, decode_walked, program
+from .factorize import factorize
 from .foxglove import SCENE_UPDATE, decode_scene_updates
 from .messages import Boxes, Coded, ImageBoxes, RawMessage, Transforms
 from .msgdef import Field, normalise, parse_schema
@@ -141,27 +142,24 @@ def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:
 
 
 def _uuid_text(raw: np.ndarray) -> Coded:
-    """Canonical UUID strings of (n, 16) bytes, as codes into the distinct ones (each formatted once)."""
-    words = np.ascontiguousarray(raw, dtype=np.uint8).view("<u8").reshape(len(raw), 2)
-    # sorted by one key per UUID (a mix of its two words), or by both words when two UUIDs share a key
-    key = words[:, 0] ^ (words[:, 1] * np.uint64(0x9E3779B97F4A7C15))
-    order = np.argsort(key)
-    ordered = words[order]
-    differ = (ordered[1:] != ordered[:-1]).any(axis=1)
-    if (differ & (key[order][1:] == key[order][:-1])).any():
-        order = np.lexsort((words[:, 1], words[:, 0]))
-        ordered = words[order]
-        differ = (ordered[1:] != ordered[:-1]).any(axis=1)
-    new = np.r_[True, differ] if len(raw) else np.zeros(0, bool)
-    inverse = np.empty(len(raw), dtype=np.int64)
-    inverse[order] = np.cumsum(new) - 1
+    """Canonical UUID strings of (n, 16) bytes, as codes into the distinct ones (each formatted
+    once). Rows are numbered by one 64-bit key per UUID (its two words mixed) without a sort
+    (:func:`.factorize.factorize`), checked against the UUIDs themselves; two UUIDs of one key
+    are told apart by a sort of the 16 bytes."""
+    raw = np.ascontiguousarray(raw, dtype=np.uint8)
+    words = raw.view("<u8").reshape(len(raw), 2)
+    key = (words[:, 0] ^ (words[:, 1] * np.uint64(0x9E3779B97F4A7C15))).view(np.int64)
+    codes, first = factorize(key)
+    if not (words == words[first][codes]).all():
+        _, first, codes = np.unique(raw.view("V16").ravel(), return_index=True, return_inverse=True)
+        codes = codes.ravel()
     texts = []
-    for value in raw[order[new]]:
+    for value in raw[first]:
         h = bytes(value).hex()
         texts.append(f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:]}")
     names = np.empty(len(texts), dtype=object)
     names[:] = texts
-    return Coded(inverse, names)
+    return Coded(codes, names)
 
 
 def _autoware(tracked: bool) -> tuple[frozenset[str], Callable[[dict[str, Level]], Boxes]]:

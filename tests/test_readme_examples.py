@@ -2,9 +2,11 @@
 
 A command block is a ```` ```console ```` fence: each line starting with ``$ `` is a command (a
 line ending in ``\\`` continues on the next), the lines up to the next command are output the
-README shows. The commands run in README order, in one temporary copy of the repository (its
-``git ls-files``, with ``../shared`` beside it), so a later example may read what an earlier one
-wrote (``fleet``, ``r.parquet``). Each must exit 0, or the code its trailing comment names
+README shows. The commands run in README order, in a temporary copy of the repository (its
+``git ls-files``, with ``../shared`` beside it) made once per test process, so a later example may
+read what an earlier one wrote (``fleet``, ``r.parquet``). The commands are split into
+:func:`groups` that share no file one of them writes, one test each, so ``pytest -n 2`` spreads
+them over its workers. Each must exit 0, or the code its trailing comment names
 (``# exit 1``); each output line shown must appear in the command's stdout or stderr, in order
 within each stream, where ``...`` in a line stands for any text and a line ``...`` alone (or
 ``... (a remark)``) for any lines. ``scenegrep`` commands without pipes or redirections run in this process
@@ -122,9 +124,57 @@ def test_the_readme_has_one_fence_for_commands():
         assert any(command.text.startswith(start) for command in found), start
 
 
-@pytest.fixture(scope="module")
+WRITES = ("-o", "--output", "--into", "--refav", "--openscenario", "--scenic", "--mcap", ">")
+"""The options (and the shell redirection) whose next word is a file or folder a command writes."""
+
+
+def _words(command: Command) -> list[str]:
+    return [word.strip("'\"") for word in command.text.split()]
+
+
+def _top(word: str) -> str:
+    """A path's first component (``fleet`` of ``fleet/runs/x``), which names what a command reads or writes."""
+    return word.split("/", 1)[0]
+
+
+def written(command: Command) -> set[str]:
+    """The first components of the paths ``command`` writes: the words after :data:`WRITES` in its
+    ``scenegrep`` part (``grep -o`` is not an output) or after a redirection."""
+    words = _words(command)
+    start = words.index("scenegrep") if "scenegrep" in words else len(words)
+    return {
+        _top(after)
+        for k, (before, after) in enumerate(zip(words, words[1:]))
+        if before == ">" or (k >= start and before in WRITES)
+    }
+
+
+def groups(found: list[Command]) -> list[list[Command]]:
+    """``found`` in groups, each in README order: a command joins every earlier group that writes a
+    path whose first component it names (or writes itself), so no group reads or overwrites what
+    another writes. The groups come largest first (the long tests start first)."""
+    members: list[list[Command]] = []
+    writes: list[set[str]] = []
+    for command in found:
+        named = {_top(word) for word in _words(command)}
+        joined = [k for k, wrote in enumerate(writes) if wrote & named]
+        group, wrote = [command], written(command)
+        for k in reversed(joined):
+            group = members.pop(k) + group
+            wrote |= writes.pop(k)
+        members.append(group)
+        writes.append(wrote)
+    members = [sorted(group, key=lambda c: c.line) for group in members]
+    return sorted(members, key=lambda group: (-len(group), group[0].line))
+
+
+GROUPS = groups([command for command in commands(README.read_text()) if not excluded(command)])
+
+
+@pytest.fixture(scope="session")
 def workspace(tmp_path_factory) -> Path:
-    """A copy of the repository's tracked files, with ../shared beside it."""
+    """A copy of the repository's tracked files, with ../shared beside it (once per test process:
+    the groups of commands write different files)."""
     root = tmp_path_factory.mktemp("readme")
     files = subprocess.run(["git", "ls-files", "-z"], cwd=REPO, capture_output=True, check=True).stdout
     copy = root / "repo"
@@ -213,15 +263,27 @@ def run(command: Command, cwd: Path, env: dict[str, str]) -> tuple[int, str, str
     return done.returncode, done.stdout, done.stderr
 
 
+def test_groups_share_no_written_path():
+    """Every command runs in one group; a path one group writes is named by no other group."""
+    assert sorted(c.line for group in GROUPS for c in group) == [
+        c.line for c in commands(README.read_text()) if not excluded(c)
+    ]
+    assert len(GROUPS) > 5
+    for k, group in enumerate(GROUPS):
+        wrote = set().union(*map(written, group))
+        for other in GROUPS[k + 1 :]:
+            assert not wrote & {_top(word) for c in other for word in _words(c)}, (group[0].line, other[0].line)
+
+
 @pytest.mark.slow
 @pytest.mark.real_data
-def test_every_readme_command_runs_as_shown(workspace, real_data):
+@pytest.mark.parametrize("group", GROUPS, ids=lambda group: f"README.md:{group[0].line}+{len(group) - 1}")
+def test_every_readme_command_runs_as_shown(group, workspace, real_data):
+    """The commands of one group, in README order (see the module docstring)."""
     env = shell_env(workspace)
     failures = []
     ran = 0
-    for command in commands(README.read_text()):
-        if excluded(command):
-            continue
+    for command in group:
         start = time.monotonic()
         code, out, err = run(command, workspace, env)
         print(f"{time.monotonic() - start:6.1f} s  exit {code}  README.md:{command.line}: {command.text[:100]}")

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Iterator
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from . import _mcap_index
 
@@ -87,9 +87,10 @@ def _string(body: memoryview, pos: int) -> tuple[str, int]:
         raise _Fault(f"malformed (a string not UTF-8: {exc.reason})") from None
 
 
-def decompress(compression: str, raw: memoryview, size: int) -> bytes:
+def decompress(compression: str, raw: memoryview, size: int, zstd: Any = None) -> bytes:
     """A chunk's records: ``raw`` decompressed to exactly ``size`` bytes (never more made);
-    McapFormatError (a bare reason) otherwise."""
+    McapFormatError (a bare reason) otherwise. ``zstd``: a ``zstandard.ZstdDecompressor`` to use
+    (a stream's reader keeps one: making one per chunk costs its context's memory each time)."""
     try:
         if compression == "":
             data = bytes(raw)
@@ -99,7 +100,7 @@ def decompress(compression: str, raw: memoryview, size: int) -> bytes:
             stated = zstandard.frame_content_size(raw)
             if stated > size:
                 raise McapFormatError(f"a zstd frame of {stated} bytes in a chunk of {size}")
-            data = zstandard.ZstdDecompressor().decompress(raw, max_output_size=size)
+            data = (zstd or zstandard.ZstdDecompressor()).decompress(raw, max_output_size=size)
         elif compression == "lz4":
             import lz4.frame
 
@@ -125,6 +126,7 @@ class Records:
         self.views = views
         self.schemas: dict[int, tuple[str, str, bytes]] = {0: ("", "", b"")}
         self.channels: dict[int, tuple[str, str, str, bytes, str]] = {}
+        self._zstd: Any = None
 
     def messages(self, offset: int, opcode: int, body: memoryview) -> Iterator[RawMessage]:
         """The messages of the record at byte ``offset`` (a Message, or a Chunk's, in order),
@@ -217,6 +219,10 @@ class Records:
             (n,) = struct.unpack_from("<Q", body, pos)
             if pos + 8 + n > len(body):
                 raise _Fault("malformed (the chunk's records run past its end)")
-            return decompress(compression, body[pos + 8 : pos + 8 + n], size)
+            if compression == "zstd" and self._zstd is None:
+                import zstandard
+
+                self._zstd = zstandard.ZstdDecompressor()
+            return decompress(compression, body[pos + 8 : pos + 8 + n], size, self._zstd)
         except (_Fault, McapFormatError) as exc:
             raise McapFormatError(describe(offset, CHUNK, str(exc))) from None

@@ -80,9 +80,17 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     module fixtures are built once): under ``pytest -n 2`` the long tests then start while the
     many short ones are still queued to fill in around them, instead of one long test at the end
     of the run leaving the other worker idle. (xdist's ``--dist loadgroup`` sends a group, such
-    as tests/library's, before single tests.) The sort is stable: otherwise collection order."""
+    as tests/library's, before single tests.) The sort is stable: otherwise collection order.
+
+    The tests that use :func:`real_dataset` (directly or through another fixture) form one xdist
+    group: the ingest, and the session fixtures and per-process caches built on it (the view's
+    query runs, tests/dataset/test_run.py's trace-by-trace reference), are then made by one
+    worker, not by both."""
     slow_files = {item.path for item in items if item.get_closest_marker("slow")}
     items.sort(key=lambda item: item.path not in slow_files)
+    for item in items:
+        if "real_dataset" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.xdist_group("real_dataset"))
     _name_xdist_groups(config, items)
 
 

@@ -1,8 +1,12 @@
 """Seed 000's four accuracy scenarios on traces simulated by Scenic (issue acceptance).
 
-Each scenario's simulation program (examples/scenarios/) runs 50 times in Scenic's Newtonian
+Each scenario's simulation program (examples/scenarios/) runs 30 times in Scenic's Newtonian
 simulator; its query (examples/queries/) must match every run (no false negative) with the
-window m = half the trace. Traces of the other scenarios and of background traffic match a
+window m = half the trace. The runs are the first 30 of the 50 that
+``benchmarks/scenario_accuracy.py`` (seed 6) simulates for the acceptance figure (runs are seeded
+one by one, so these are the same traces): a query that misses a fraction p of runs fails here
+with probability 1 - (1 - p)^30 (p = 10%: 96%, p = 5%: 79%; 50 runs: 99.5% and 92%) at 60% of the
+simulation time, which is nearly all of this test's. Traces of the other scenarios and of background traffic match a
 query only where the brute-force reference (tests/scenario/reference.py) says they truly
 satisfy it.
 """
@@ -24,7 +28,7 @@ SCENARIOS = {
     "s3_pass_pedestrian": "Town01",
     "s4_yield_right_turn": "Town01",
 }
-RUNS = 50
+RUNS = 30
 STEPS = 150
 WINDOW = STEPS // 2
 

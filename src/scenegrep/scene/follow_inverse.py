@@ -20,7 +20,14 @@ centreline of the lane or shoulder holding it (or, in an intersection area or wi
 lane, of the nearest one), which lies within the lane's reach of the point (the farthest point of
 the lane from its centreline) plus the widest gap of an intersection area outside its lanes. A
 candidate is also dropped when p_k's segment stays farther than that from every segment with its
-heading (no point of that segment can take it).
+heading (no point of that segment can take it). Every rule reads the heading off the segment
+of a centreline (a lane's or a shoulder's) holding the point's nearest point of that centreline
+(:meth:`~..model.polylines.Polylines.segment_at`), so a segment gives its heading only where that
+nearest point may lie on it: not where the point lies :data:`FOOT_SLACK_M` or more before the
+segment's start along it and along the segment before it (whose end is then nearer), nor that far
+past its end along it and along the next segment. Each candidate segment's D interval is
+narrowed to the hull of the D left (Town01's centreline segments are 0.2-0.5 m long and a reach
+some metres, so most candidates fall away here rather than in the cutting below).
 
 Why the preimage holds every walk ending at E (the invariant a refutation rests on): take a walk
 from X for D with headings h_0 .. h_{n-1} and points p_0 = X .. p_n = E. Going back from p_{k+1},
@@ -65,6 +72,17 @@ from .regions import Field
 REACH_MARGIN_M = 0.25
 """Added to the farthest distance at which a centreline segment may give a point its heading."""
 
+FOOT_SLACK_M = 1e-3
+"""How far a point may lie before a segment's start (or past its end), along it and along the
+segment before (after) it, and still count as nearest to it (metres): wide enough that rounding in
+the projection that picks the nearest segment cannot lose one (a point that far past a vertex
+along both segments, the next one at least :data:`NEIGHBOUR_M` long, lies at least 5e-8 m nearer
+the next one within 10 m, against rounding below 1e-10 m)."""
+
+NEIGHBOUR_M = 0.01
+"""A neighbouring segment shorter than this (metres) is not used to narrow a segment's D
+interval (too short to be surely nearer by more than rounding)."""
+
 
 DOMAIN_SLACK_M = 1e-6
 """Slack on the reach of a branch's remaining steps towards the start's domain (metres)."""
@@ -73,14 +91,19 @@ DOMAIN_SLACK_M = 1e-6
 @dataclass
 class Inverse:
     """Per map: every centreline segment (lanes, then shoulders): an R-tree of the boxes within
-    its reach, its heading (radians), its ends (rows of x0, y0, x1, y1) and its reach (metres:
-    no point farther from it takes its heading); and the union of the lanes, intersection areas
-    and shoulders (off which a point may take heading 0)."""
+    its reach, its heading (radians), its ends (rows of x0, y0, x1, y1), its reach (metres:
+    no point farther from it takes its heading), its unit direction and those of the segments
+    before and after it on its centreline (rows of x, y; NaN: none, or shorter than
+    :data:`NEIGHBOUR_M`); and the union of the lanes, intersection areas and shoulders (off which
+    a point may take heading 0)."""
 
     tree: shapely.STRtree
     heading: np.ndarray
     ends: np.ndarray
     reach: np.ndarray
+    unit: np.ndarray
+    before: np.ndarray
+    after: np.ndarray
     roads: shapely.Geometry
 
 
@@ -148,13 +171,32 @@ def _build_inverse(geometry: MapGeometry) -> Inverse:
     start = np.concatenate([c.start for c in centres])
     end = np.concatenate([c.end for c in centres])
     heading = np.concatenate([c.heading for c in centres])
+    unit, before, after = (np.concatenate(parts) for parts in zip(*(_neighbours(c) for c in centres)))
     reach = np.concatenate(reaches) + REACH_MARGIN_M
     low, high = np.minimum(start, end) - reach[:, None], np.maximum(start, end) + reach[:, None]
     near = shapely.box(low[:, 0], low[:, 1], high[:, 0], high[:, 1])
     areas = [lanes] + [a.polygon for a in road_map.intersections] + [a.polygon for a in road_map.shoulders]
     roads = shapely.union_all(areas)
     shapely.prepare(roads)
-    return Inverse(shapely.STRtree(near), heading, np.concatenate([start, end], axis=1), reach, roads)
+    ends = np.concatenate([start, end], axis=1)
+    return Inverse(shapely.STRtree(near), heading, ends, reach, unit, before, after, roads)
+
+
+def _neighbours(lines: Polylines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each segment's unit direction and those of the segments before and after it on its polyline
+    (NaN rows: none, or shorter than :data:`NEIGHBOUR_M`)."""
+    w = lines.end - lines.start
+    length = np.hypot(w[:, 0], w[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        unit = w / length[:, None]
+    usable = np.where((length >= NEIGHBOUR_M)[:, None], unit, np.nan)
+    owner = np.repeat(np.arange(len(lines)), lines.count)
+    index = np.arange(len(owner))
+    first = index == lines.first[owner]
+    last = index == (lines.first + lines.count - 1)[owner]
+    before = np.where(first[:, None], np.nan, np.roll(usable, 1, axis=0))
+    after = np.where(last[:, None], np.nan, np.roll(usable, -1, axis=0))
+    return unit, before, after
 
 
 def _reach(polygons: np.ndarray, lines: Polylines) -> np.ndarray:
@@ -268,7 +310,7 @@ def _candidates(inv: Inverse, ex, ey, b: _Back) -> _Moved:
     )
     branch, segment = inv.tree.query(boxes)
     heading = inv.heading[segment]
-    lo, hi = _within(ex, ey, b, branch, heading, (inv.ends[segment], inv.reach[segment]), inv.roads)
+    lo, hi = _within(ex, ey, b, branch, heading, (inv, segment), inv.roads)
     zero = _within(ex, ey, b, np.arange(len(b.row)), np.zeros(len(b.row)), None, inv.roads)
     branch = np.concatenate([branch, np.arange(len(b.row))])
     heading = np.concatenate([heading, np.zeros(len(b.row))])
@@ -292,8 +334,10 @@ def _candidates(inv: Inverse, ex, ey, b: _Back) -> _Moved:
 
 def _within(ex, ey, b: _Back, branch, heading, near, roads) -> tuple[np.ndarray, np.ndarray]:
     """The D interval (lo > hi: none) on which branch ``branch[i]``'s point one step back along
-    ``heading[i]`` comes within ``near[1][i]`` metres of the segment ``near[0][i]`` (rows of
-    x0, y0, x1, y1), as the hull of that set; with ``near`` None, where it may leave the roads."""
+    ``heading[i]`` comes within its reach of the segment ``near[1][i]`` of ``near[0]`` (an
+    :class:`Inverse`) where its centreline's nearest point may lie on that segment
+    (:func:`_nearest_on`), as the hull of that set; with ``near`` None, where it may leave the
+    roads."""
     ax = b.ax[branch] + np.sin(heading) / b.steps[branch]
     ay = b.ay[branch] + -np.cos(heading) / b.steps[branch]
     lo, hi = b.lo[branch], b.hi[branch]
@@ -303,17 +347,50 @@ def _within(ex, ey, b: _Back, branch, heading, near, roads) -> tuple[np.ndarray,
     if near is None:
         off = ~shapely.covered_by(shapely.linestrings(np.stack([p, q], axis=1)), roads)
         return np.where(off, lo, np.inf), np.where(off, hi, -np.inf)
-    ends, reach = near
+    inv, segment = near
+    ends, reach = inv.ends[segment], inv.reach[segment]
     low = np.minimum(ends[:, :2], ends[:, 2:]) - reach[:, None]
     high = np.maximum(ends[:, :2], ends[:, 2:]) + reach[:, None]
     meet = np.flatnonzero(np.all((np.minimum(p, q) <= high) & (np.maximum(p, q) >= low), axis=1))
     t_lo, t_hi = np.full(len(p), np.inf), np.full(len(p), -np.inf)
-    t_lo[meet], t_hi[meet] = _stadium(p[meet], (q - p)[meet], ends[meet, :2], ends[meet, 2:], reach[meet])
+    start, stop, r, s = ends[meet, :2], ends[meet, 2:], (q - p)[meet], segment[meet]
+    t_lo[meet], t_hi[meet] = _nearest_on(
+        p[meet],
+        r,
+        (start, stop),
+        inv.unit[s],
+        (inv.before[s], inv.after[s]),
+        _stadium(p[meet], r, start, stop, reach[meet]),
+    )
     hit = np.flatnonzero(t_lo <= t_hi)  # elsewhere t_hi may be -inf, and -inf * 0 (a point interval) is NaN
     start, end = np.full(len(p), np.inf), np.full(len(p), -np.inf)
     start[hit] = lo[hit] + t_lo[hit] * (hi[hit] - lo[hit])
     end[hit] = lo[hit] + t_hi[hit] * (hi[hit] - lo[hit])
     return start, end
+
+
+def _nearest_on(p, r, ends, unit, neighbours, span) -> tuple[np.ndarray, np.ndarray]:
+    """``span`` ([t_lo, t_hi] per row) narrowed to the hull of the t at which the nearest point of
+    its centreline to p + t r may lie on the segment ``ends`` (its start rows, its end rows;
+    ``unit``: its direction): dropped are the t at which the point lies :data:`FOOT_SLACK_M` or
+    more before the start along it and along the segment before (``neighbours[0]``: its direction;
+    NaN: none), whose end is then nearer, and likewise past the end along it and the segment after
+    (``neighbours[1]``)."""
+    low, high = span
+    forbidden = []
+    for vertex, sign, neighbour in ((ends[0], -1.0, neighbours[0]), (ends[1], 1.0, neighbours[1])):
+        f_lo, f_hi = np.zeros(len(p)), np.ones(len(p))
+        for direction in (unit, neighbour):
+            along = sign * np.einsum("ij,ij->i", p - vertex, direction)
+            rate = sign * np.einsum("ij,ij->i", r, direction)
+            f_lo, f_hi = _linear_within(f_lo, f_hi, along, rate, FOOT_SLACK_M, np.inf)
+        none = np.isnan(f_lo) | np.isnan(f_hi) | np.isnan(neighbour[:, 0])
+        forbidden.append((np.where(none, np.inf, f_lo), np.where(none, -np.inf, f_hi)))
+    for _ in range(2):
+        for f_lo, f_hi in forbidden:
+            low = np.where((low >= f_lo) & (low <= f_hi), f_hi, low)
+            high = np.where((high >= f_lo) & (high <= f_hi), f_lo, high)
+    return low, high
 
 
 def _stadium(p, r, a, b, radius) -> tuple[np.ndarray, np.ndarray]:

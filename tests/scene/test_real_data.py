@@ -303,37 +303,56 @@ def fig3_car_ahead(hand: Hand, f: int, tol: float = LOOSE.position, heading_tol:
     )
 
 
+@cache
+def curb_segments(hand: Hand) -> tuple[np.ndarray, np.ndarray]:
+    """Every curb segment of the hand's map as its start and its vector (zero-length ones left out), in
+    the order of the curbs and of their points."""
+    curbs = [np.asarray(curb, dtype=float) for curb in hand.map.curbs]
+    starts = np.concatenate([curb[:-1] for curb in curbs])
+    vectors = np.concatenate([np.diff(curb, axis=0) for curb in curbs])
+    keep = vectors.any(axis=1)
+    return starts[keep], vectors[keep]
+
+
+def to_segments(point: np.ndarray, starts: np.ndarray, vectors: np.ndarray) -> np.ndarray:
+    """The distance from ``point`` to each segment from ``starts[i]`` to ``starts[i] + vectors[i]``."""
+    t = np.clip(((point - starts) * vectors).sum(axis=1) / (vectors**2).sum(axis=1), 0.0, 1.0)
+    return np.hypot(*(point - starts - t[:, None] * vectors).T)
+
+
 def fig6_witness(hand: Hand, f: int, side: str, tol: float = 1.0, heading_tol: float = 15) -> dict | None:
     """A spot on a curb segment (and offsets) reproducing the ego and sideCar of Fig. 6 within tol: one
-    linear feasibility problem per curb segment, in (t along the segment, ego's offset a, b, side gap d)."""
+    linear feasibility problem per curb segment, in (t along the segment, ego's offset a, b, side gap d),
+    the first feasible in curb order. A segment the car's heading is not along, or farther from the ego
+    than its largest offset or from the car than its largest gap, plus the tolerance (``tol`` in x and
+    in y), is not solved: its problem has no solution."""
     ego, car = hand.frames[f]["ego"], hand.frames[f][side]
     if not hand.follows_road(ego, -heading_tol, heading_tol):
         return None
-    for curb in hand.map.curbs:
-        curb = np.asarray(curb, dtype=float)
-        for p, q in zip(curb[:-1], curb[1:]):
-            v = q - p
-            if not v.any() or min(
-                np.hypot(*(p - (ego["x"], ego["y"]))), np.hypot(*(q - (ego["x"], ego["y"])))
-            ) > 20 + np.hypot(*v):
-                continue
-            h = math.atan2(-v[0], v[1])
-            if abs(float(wrap(car["h"] - h))) > heading_tol * DEG:
-                continue
-            c, s = math.cos(h), math.sin(h)
-            # ego = p + t v + rotate(h, a, b); side = p + t v + rotate(h, -(w/2 + d), 0)
-            rows = [
-                ([v[0], c, -s, 0], ego["x"] - p[0]),
-                ([v[1], s, c, 0], ego["y"] - p[1]),
-                ([v[0], 0, 0, -c], car["x"] - p[0] + c * car["w"] / 2),
-                ([v[1], 0, 0, -s], car["y"] - p[1] + s * car["w"] / 2),
-            ]
-            lhs = [r for r, _ in rows] + [[-x for x in r] for r, _ in rows]
-            rhs = [t + tol for _, t in rows] + [tol - t for _, t in rows]
-            found = linprog(np.zeros(4), A_ub=lhs, b_ub=rhs, bounds=[(0, 1), (2, 4), (5, 10), (1, 3)])
-            if found.status == 0:
-                t, a, b, d = found.x
-                return {"spot": tuple(p + t * v), "curb heading": h, "offset": (a, b), "gap": d}
+    starts, vectors = curb_segments(hand)
+    headings = np.arctan2(-vectors[:, 0], vectors[:, 1])
+    slack = math.sqrt(2) * tol + 1e-9
+    candidates = (
+        (np.abs(wrap(car["h"] - headings)) <= heading_tol * DEG)
+        & (to_segments(np.array([ego["x"], ego["y"]]), starts, vectors) <= math.hypot(4, 10) + slack)
+        & (to_segments(np.array([car["x"], car["y"]]), starts, vectors) <= car["w"] / 2 + 3 + slack)
+    )
+    for k in np.flatnonzero(candidates):
+        p, v, h = starts[k], vectors[k], float(headings[k])
+        c, s = math.cos(h), math.sin(h)
+        # ego = p + t v + rotate(h, a, b); side = p + t v + rotate(h, -(w/2 + d), 0)
+        rows = [
+            ([v[0], c, -s, 0], ego["x"] - p[0]),
+            ([v[1], s, c, 0], ego["y"] - p[1]),
+            ([v[0], 0, 0, -c], car["x"] - p[0] + c * car["w"] / 2),
+            ([v[1], 0, 0, -s], car["y"] - p[1] + s * car["w"] / 2),
+        ]
+        lhs = [r for r, _ in rows] + [[-x for x in r] for r, _ in rows]
+        rhs = [t + tol for _, t in rows] + [tol - t for _, t in rows]
+        found = linprog(np.zeros(4), A_ub=lhs, b_ub=rhs, bounds=[(0, 1), (2, 4), (5, 10), (1, 3)])
+        if found.status == 0:
+            t, a, b, d = found.x
+            return {"spot": tuple(p + t * v), "curb heading": h, "offset": (a, b), "gap": d}
     return None
 
 

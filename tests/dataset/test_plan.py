@@ -4,7 +4,6 @@ for a correspondence, SpRE class requirements against the SpRE engine's matches.
 from __future__ import annotations
 
 import itertools
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -50,21 +49,28 @@ def could_match(trace: LabelTrace, objects: list, m: int) -> bool:
     return False
 
 
-def catalog_of(root: Path, trace: LabelTrace) -> Catalog:
-    catalog = Catalog(root, create=True)
+@pytest.fixture(scope="module")
+def catalog(tmp_path_factory):
+    """One catalog for the module's examples (creating one takes 0.1 s): :func:`holding` puts each
+    example's trace in it in place of the previous one."""
+    with Catalog(tmp_path_factory.mktemp("plan"), create=True) as catalog:
+        yield catalog
+
+
+def holding(catalog: Catalog, trace: LabelTrace) -> Catalog:
+    """``catalog`` with ``trace`` as its only trace (of the source ``s``, whose earlier traces it forgets)."""
     stats = TraceStatistics.of(trace)
     row = {"trace_id": "t", **stats.trace, "source_path": "s", "file": "f", "map_id": None}
     catalog.replace_sources([({"path": "s", "format": "x", "checksum": "c"}, [(row, stats)])])
+    assert catalog.rows("SELECT count(*) FROM traces") == [(1,)]
     return catalog
 
 
 @settings(max_examples=120)
 @given(traces(), st.lists(st.sampled_from(KIND_SETS), min_size=1, max_size=3), st.integers(1, 4), st.data())
-def test_kind_pruning_keeps_every_trace_that_could_match(tmp_path_factory, trace, kind_sets, m, data):
+def test_kind_pruning_keeps_every_trace_that_could_match(catalog, trace, kind_sets, m, data):
     objects = [SimpleNamespace(kinds=k) for k in kind_sets]
-    root = tmp_path_factory.mktemp("plan")
-    with catalog_of(root, trace) as catalog:
-        result = plan(catalog, Needs(kind_groups(objects), m))
+    result = plan(holding(catalog, trace), Needs(kind_groups(objects), m))
     if could_match(trace, objects, m):
         assert result.kept and not result.pruned
     if not result.pruned:
@@ -79,14 +85,13 @@ def test_kind_pruning_keeps_every_trace_that_could_match(tmp_path_factory, trace
     st.integers(1, 4),
     st.sampled_from([frozenset(), frozenset({"pedestrian"})]),
 )
-def test_the_trace_planner_gives_the_catalog_planners_reasons(tmp_path_factory, sequence, kind_sets, m, classes):
+def test_the_trace_planner_gives_the_catalog_planners_reasons(catalog, sequence, kind_sets, m, classes):
     """A query over files plans trace after trace with one TracePlanner: each reason is the one
     plan() gives on a dataset's catalog holding that trace."""
     needs = Needs(kind_groups([SimpleNamespace(kinds=k) for k in kind_sets]), m, classes)
     with TracePlanner(needs) as planner:
         for trace in sequence:
-            with catalog_of(tmp_path_factory.mktemp("plan"), trace) as catalog:
-                expected = plan(catalog, needs).pruned
+            expected = plan(holding(catalog, trace), needs).pruned
             stats = TraceStatistics.of(trace)
             row = {"trace_id": "t", **stats.trace, "source_path": "s", "file": "f", "map_id": None}
             assert planner.prune_reason(row, stats) == (expected[0][1] if expected else None)

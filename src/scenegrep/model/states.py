@@ -42,7 +42,8 @@ class StateTable(RowTable):
     ) -> StateTable:
         """Make a table from array-likes (missing optional columns become NaN / -1), in the given row order."""
         n = len(frame)
-        nan = np.full(n, np.nan)
+        missing = any(c is None for c in (z, length, width, height, vx, vy))
+        nan = np.full(n, np.nan) if missing else None  # (one array for every missing column; none when none is)
         table = cls(
             frame=int_column(frame),
             object=int_column(object),

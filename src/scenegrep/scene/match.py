@@ -10,6 +10,16 @@ correspondences that extend a known-bad partial one (badOCs), done breadth
 first and vectorised over frames. A frame matches when a row survives every
 group (and, with ``exact``, uses every label object in view).
 
+Before a group with random variables (whose rows go to the solvers, the dear part) the later
+groups without any whose objects are all in the rows already are checked first (a frame turned
+away from the road is refuted by its heading group before its position group inverts a walk):
+a row that fails one is dropped either way, so the rows that survive every group are the same. Only
+the first group a frame fails (``failed_group``, what ``--explain`` and the nearest misses name)
+depends on the order: for a frame that lost rows to a group checked early and then died, it is
+found again in the documented order, without checking early, when first asked for. With a choice
+for unknown map layers (``--unknown-layers``) nothing is checked early: its report counts each
+decision under the first layer that made it, in the documented order.
+
 The program's ego corresponds to the trace's ego object when the trace names
 one (the sensor platform); ``visible_distance`` keeps only label objects whose
 centre is within that many metres of the ego, and restricts random points to
@@ -19,7 +29,8 @@ that disc around it (seed 003's crop of the map).
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, field
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -53,16 +64,30 @@ class SceneOptions:
 class TraceMatches:
     """Per frame of one trace: matched or not, the first surviving correspondence (program object ->
     label object id) and, for frames that fail, the index (into ``groups``, the groups checked) of
-    the first group no row survived; ``survivors`` holds the first surviving row of each matched
-    frame, in frame order; ``notes`` counts the row solvers' verdicts."""
+    the first group no row survived (``failed_group``); ``survivors`` holds the first surviving row
+    of each matched frame, in frame order; ``notes`` counts the row solvers' verdicts.
+    ``unsure`` marks the frames whose ``found_failed`` may be too early (they lost rows to a group
+    checked early) and ``recheck`` finds theirs in the documented order."""
 
     matched: np.ndarray
     correspondence: list[dict[str, str] | None]
-    failed_group: np.ndarray
+    found_failed: np.ndarray
     groups: list[Group]
     survivors: Rows
     notes: Counter = field(default_factory=Counter)
     every: Rows | None = None
+    unsure: np.ndarray | None = None
+    recheck: Callable[[np.ndarray], np.ndarray] | None = None
+
+    @property
+    def failed_group(self) -> np.ndarray:
+        """Per frame, the index of the first group (in the documented order) no row survived (-1:
+        matched)."""
+        if self.unsure is not None and self.unsure.any() and self.recheck is not None:
+            frames = np.flatnonzero(self.unsure)
+            self.found_failed[frames] = self.recheck(frames)[frames]
+            self.unsure = None
+        return self.found_failed
 
 
 class Candidates:
@@ -149,23 +174,45 @@ def labels_of(trace: LabelTrace) -> Labels:
 
 
 def match_trace(
-    scene: SceneProgram, groups: list[Group], trace: LabelTrace, geometry: MapGeometry, options: SceneOptions
+    scene: SceneProgram,
+    groups: list[Group],
+    trace: LabelTrace,
+    geometry: MapGeometry,
+    options: SceneOptions,
+    early: bool = True,
 ) -> TraceMatches:
-    """Algorithm 1 for every frame of ``trace`` (see the module docstring)."""
+    """Algorithm 1 for every frame of ``trace`` (see the module docstring; ``early``: check the
+    groups without random variables early, unless a choice for unknown layers is made)."""
     labels = labels_of(trace)
     objects = {o.name: o for o in scene.objects}
     candidates = Candidates(trace, options)
     frames = np.arange(trace.n_frames) if options.frames is None else np.asarray(options.frames, dtype=np.intp)
     rows = Rows(frames, {})
     failed = np.full(trace.n_frames, -1, dtype=np.intp)
+    unsure = np.zeros(trace.n_frames, dtype=bool)
     notes: Counter = Counter()
+    present: set[str] = set()
+    done: set[int] = set()
+
+    def keep(rows: Rows, group: Group) -> Rows:
+        ev = Evaluator(rows, labels, objects, geometry, position_tolerance=options.tolerance.position)
+        kept = rows.take(np.flatnonzero(decide(ev, group, options.tolerance)))
+        notes.update(ev.notes)
+        return kept
+
     for g, group in enumerate(groups):
         for name in group.introduces:
             rows = extend(rows, name, *candidates.for_object(objects[name]))
-        if len(rows):
-            ev = Evaluator(rows, labels, objects, geometry, position_tolerance=options.tolerance.position)
-            rows = rows.take(np.flatnonzero(decide(ev, group, options.tolerance)))
-            notes.update(ev.notes)
+        present.update(group.introduces)
+        if early and group.unknowns and options.unknown_layers is None:
+            for h in range(g + 1, len(groups)):
+                if len(rows) and h not in done and not groups[h].unknowns and groups[h].objects <= present:
+                    before = np.bincount(rows.frame, minlength=trace.n_frames)
+                    rows = keep(rows, groups[h])
+                    done.add(h)
+                    unsure |= np.bincount(rows.frame, minlength=trace.n_frames) < before
+        if len(rows) and g not in done:
+            rows = keep(rows, group)
         _record_failures(failed, rows, g)
     if options.exact:
         used = len(scene.objects)
@@ -175,7 +222,14 @@ def match_trace(
     matched[rows.frame] = True
     rows = rows.take(np.argsort(rows.frame, kind="stable"))
     survivors = rows.take(np.unique(rows.frame, return_index=True)[1])
-    return TraceMatches(matched, _correspondences(survivors, trace), failed, groups, survivors, notes, rows)
+    unsure &= failed >= 0
+
+    def recheck(frames: np.ndarray) -> np.ndarray:
+        found = match_trace(scene, groups, trace, geometry, replace(options, frames=frames), early=False)
+        return found.failed_group
+
+    correspondence = _correspondences(survivors, trace)
+    return TraceMatches(matched, correspondence, failed, groups, survivors, notes, rows, unsure, recheck)
 
 
 def _record_failures(failed: np.ndarray, rows: Rows, g: int) -> None:

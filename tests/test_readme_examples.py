@@ -43,7 +43,6 @@ README = REPO / "README.md"
 EXCLUDED = {
     "python3 -m venv .venv && .venv/bin/pip install": "installs packages from the network into a new venv "
     "(tests/test_readme.py runs the first quick-start command's scenegrep part)",
-    "duckdb ": "the DuckDB shell is not a dependency (fleet.sql in the Python example below reads the catalog)",
 }
 """Commands (by how they start) that this test does not run, and why."""
 

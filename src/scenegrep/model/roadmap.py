@@ -146,6 +146,9 @@ class RoadMap:
 
     @cached_property
     def _lane_tree(self) -> STRtree:
+        """An R-tree of the lane polygons, prepared (GEOS indexes each one once, for the many
+        point-in-lane tests made while walking: the same answers, faster)."""
+        shapely.prepare(self.lane_polygons)
         return STRtree(self.lane_polygons)
 
     @cached_property

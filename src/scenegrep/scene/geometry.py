@@ -489,15 +489,17 @@ class MapGeometry:
             chosen[rows[_firsts(rows)]] = headings[_firsts(rows)]
             return chosen
         road_map = self._require_map()
-        rows, lanes = road_map.lanes_containing(x, y)
+        points = shapely.points(x, y)
         lane = np.full(len(x), -1, dtype=np.intp)
-        lane[rows[_firsts(rows)]] = lanes[_firsts(rows)]
         if len(x):
-            self._intersection_choice(x, y, lane)
+            if len(road_map.lanes):
+                rows, lanes = _first_per_point(*road_map._lane_tree.query(points, predicate="intersects"))
+                lane[rows] = lanes
+            self._intersection_choice(points, lane)
         chosen = np.zeros(len(x))
         off = np.flatnonzero(lane < 0)
         if len(off):
-            chosen[off] = self._off_lanes(x[off], y[off])
+            chosen[off] = self._off_lanes(x[off], y[off], points[off])
         on = np.flatnonzero(lane >= 0)
         chosen[on] = road_map.centreline_polylines.direction_at(lane[on], x[on], y[on])
         return chosen
@@ -511,14 +513,15 @@ class MapGeometry:
             return None
         return STRtree(np.array([a.polygon for a in areas], dtype=object)), Polylines([a.centreline for a in areas])
 
-    def _off_lanes(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def _off_lanes(self, x: np.ndarray, y: np.ndarray, points: np.ndarray | None = None) -> np.ndarray:
         """Scenic's road direction at points in no lane and no intersection area: the first shoulder
         holding the point; else, within :data:`ELEMENT_REACH_M` (Scenic's second pass over its
         elements, in its order), an intersection (its lane as inside one), the nearest lane
-        (standing for the lane of its road), the first shoulder; else 0 (radians)."""
+        (standing for the lane of its road), the first shoulder; else 0 (radians). ``points``: the
+        points as shapely points when the caller has them."""
         road_map = self._require_map()
         chosen = np.zeros(len(x))
-        points = shapely.points(x, y)
+        points = shapely.points(x, y) if points is None else points
         shoulders = self._shoulders
         if shoulders is not None:
             point, shoulder = _first_per_point(*shoulders[0].query(points, predicate="intersects"))
@@ -528,7 +531,7 @@ class MapGeometry:
             rest = np.arange(len(x))
         lane = np.full(len(rest), -1, dtype=np.intp)
         if len(rest):
-            self._intersection_choice(x[rest], y[rest], lane, ELEMENT_REACH_M)
+            self._intersection_choice(points[rest], lane, ELEMENT_REACH_M)
         free = np.flatnonzero(lane < 0)
         if len(free) and len(road_map.lanes):
             nearest = road_map._lane_tree.nearest(points[rest[free]])
@@ -543,19 +546,20 @@ class MapGeometry:
             chosen[free[point]] = lines.direction_at(shoulder, x[free[point]], y[free[point]])
         return chosen
 
-    def _intersection_choice(self, x: np.ndarray, y: np.ndarray, lane: np.ndarray, reach: float = 0.0) -> None:
-        """Points in an intersection area (or within ``reach`` metres of one) take the first of its
-        lanes containing them, else the nearest (the first such intersection area counts): set in
-        ``lane``."""
+    def _intersection_choice(self, points: np.ndarray, lane: np.ndarray, reach: float = 0.0) -> None:
+        """Points (shapely) in an intersection area (or within ``reach`` metres of one) take the first
+        of its lanes containing them, else the nearest (the first such intersection area counts):
+        set in ``lane``."""
         road_map = self._require_map()
         tree, flat, starts = self._intersection_areas
         if not len(flat):
             return
-        points = shapely.points(x, y)
         if reach > 0:
             point, area = tree.query(points, predicate="dwithin", distance=reach)
         else:
             point, area = tree.query(points, predicate="intersects")
+        if not len(point):
+            return
         point, area = _first_per_point(point, area)
         counts = starts[area + 1] - starts[area]
         group = np.repeat(np.arange(len(point)), counts)

@@ -13,12 +13,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.scene import follow_pieces
-from scenegrep.scene.follow import walk_end
 from scenegrep.scene.follow_inverse import preimages
 from scenegrep.scene.follow_pieces import ONLY_RAD, _equal_distances, _segment_crossings, _wrap
 from scenegrep.scene.heading_index import WINDOW_RAD, heading_index, near_heading
 from tests.scene.test_follow import FIELD
-from tests.scene.test_follow_start import town01
+from tests.scene.test_follow_start import town01_walks
 
 ANGLES = st.sampled_from([0.0, 1e-7, -1e-7, np.pi / 2, np.pi, -np.pi, 2 * np.pi - 1e-9, 3.0, np.nan])
 
@@ -85,17 +84,7 @@ def rows(pre) -> list[tuple]:
 def test_town01_preimages_equal_those_of_the_r_tree_step(monkeypatch):
     """The preimages of 150 Town01 walk ends (random starts near the roads, D forwards and backwards,
     the first heading checked and not) equal, row for row, those with the reference's cuts."""
-    found = town01()
-    if found is None:
-        pytest.skip("../shared/maps/Town01.xodr is absent")
-    geometry, roads = found
-    rng = np.random.default_rng(15)
-    x0, y0, x1, y1 = roads.bounds
-    points = shapely.points(rng.uniform(x0, x1, 3000), rng.uniform(y0, y1, 3000))
-    x, y = shapely.get_coordinates(points[shapely.dwithin(points, roads, 2.0)][:150]).T
-    distance = np.where(rng.random(len(x)) < 0.5, rng.uniform(-30, -20, len(x)), rng.uniform(10, 20, len(x)))
-    ex, ey = walk_end(geometry, FIELD, x, y, distance, None)
-    lo, hi = np.where(distance < 0, -30.0, 10.0), np.where(distance < 0, -20.0, 20.0)
+    geometry, x, y, _, ex, ey, lo, hi = town01_walks(15, 3000, 150)
     new = [rows(preimages(geometry, FIELD, ex, ey, lo, hi, check)) for check in (True, False)]
     monkeypatch.setattr(follow_pieces, "crossings", reference_crossings)
     old = [rows(preimages(geometry, FIELD, ex, ey, lo, hi, check)) for check in (True, False)]

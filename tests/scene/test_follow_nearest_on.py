@@ -9,15 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.scene import follow_inverse
-from scenegrep.scene.follow import walk_end
 from scenegrep.scene.follow_inverse import _nearest_on, inverse, preimages
 from tests.scene.test_follow import FIELD
-from tests.scene.test_follow_start import town01
+from tests.scene.test_follow_start import town01, town01_walks
 
 
 def geometry_or_skip():
@@ -64,15 +62,7 @@ def test_town01_preimages_equal_those_without_the_narrowing(monkeypatch):
     another parametrisation; a piece at most 1e-9 m wide, D at a cut, may go); with it unchecked
     (a curb start's), each row lies within one of those; either way the walk's own start and
     distance are in it."""
-    geometry = geometry_or_skip()
-    roads = town01()[1]
-    rng = np.random.default_rng(16)
-    x0, y0, x1, y1 = roads.bounds
-    points = shapely.points(rng.uniform(x0, x1, 2000), rng.uniform(y0, y1, 2000))
-    x, y = shapely.get_coordinates(points[shapely.dwithin(points, roads, 2.0)][:60]).T
-    distance = np.where(rng.random(len(x)) < 0.5, rng.uniform(-30, -20, len(x)), rng.uniform(10, 20, len(x)))
-    ex, ey = walk_end(geometry, FIELD, x, y, distance, None)
-    lo, hi = np.where(distance < 0, -30.0, 10.0), np.where(distance < 0, -20.0, 20.0)
+    geometry, x, y, distance, ex, ey, lo, hi = town01_walks(16, 2000, 60)
     narrowed = [preimages(geometry, FIELD, ex, ey, lo, hi, check) for check in (True, False)]
     monkeypatch.setattr(follow_inverse, "_nearest_on", lambda p, r, ends, unit, neighbours, span: span)
     whole = [rows(preimages(geometry, FIELD, ex, ey, lo, hi, check)) for check in (True, False)]

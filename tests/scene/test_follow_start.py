@@ -331,6 +331,25 @@ def town01():
     return geometry, shapely.union_all(list(road_map.lane_polygons) + [a.polygon for a in road_map.intersections])
 
 
+def town01_walks(seed: int, candidates: int, n: int):
+    """Up to ``n`` random Town01 walks for preimage tests: starts among ``candidates`` uniform points
+    of the map's bounds that lie within 2 m of its roads, D backwards in [-30, -20] or forwards in
+    [10, 20] m (even odds), their ends by the forward walk, and the D range [lo, hi] of each walk's
+    preimage: ``(geometry, x, y, distance, ex, ey, lo, hi)``. Skips the test without ../shared."""
+    found = town01()
+    if found is None:
+        pytest.skip("../shared/maps/Town01.xodr is absent")
+    geometry, roads = found
+    rng = np.random.default_rng(seed)
+    x0, y0, x1, y1 = roads.bounds
+    points = shapely.points(rng.uniform(x0, x1, candidates), rng.uniform(y0, y1, candidates))
+    x, y = shapely.get_coordinates(points[shapely.dwithin(points, roads, 2.0)][:n]).T
+    distance = np.where(rng.random(len(x)) < 0.5, rng.uniform(-30, -20, len(x)), rng.uniform(10, 20, len(x)))
+    ex, ey = walk_end(geometry, FIELD, x, y, distance, None)
+    lo, hi = np.where(distance < 0, -30.0, 10.0), np.where(distance < 0, -20.0, 20.0)
+    return geometry, x, y, distance, ex, ey, lo, hi
+
+
 FOLD_WALK = (383.9042117863049, -325.00586555318347, -26.895910784641323, -30.0, 30.0)
 """A Town01 walk (x, y, D, and the D range inverted) whose second step starts beside a centreline
 that folds back (road 14's lane 0: a 0.08 m segment against its neighbour's direction): the

@@ -309,12 +309,9 @@ def _candidates(inv: Inverse, ex, ey, b: _Back) -> _Moved:
         np.minimum(px, qx) - grow, np.minimum(py, qy) - grow, np.maximum(px, qx) + grow, np.maximum(py, qy) + grow
     )
     branch, segment = inv.tree.query(boxes)
-    heading = inv.heading[segment]
-    lo, hi = _within(ex, ey, b, branch, heading, (inv, segment), inv.roads)
-    zero = _within(ex, ey, b, np.arange(len(b.row)), np.zeros(len(b.row)), None, inv.roads)
     branch = np.concatenate([branch, np.arange(len(b.row))])
-    heading = np.concatenate([heading, np.zeros(len(b.row))])
-    lo, hi = np.concatenate([lo, zero[0]]), np.concatenate([hi, zero[1]])
+    heading = np.concatenate([inv.heading[segment], np.zeros(len(b.row))])
+    lo, hi = _within(ex, ey, b, branch, heading, inv, segment)
     keep = lo <= hi
     branch, heading, lo, hi = branch[keep], heading[keep], lo[keep], hi[keep]
     order = np.lexsort((heading, branch))
@@ -332,38 +329,38 @@ def _candidates(inv: Inverse, ex, ey, b: _Back) -> _Moved:
     return _Moved(moved, heading, branch[starts])
 
 
-def _within(ex, ey, b: _Back, branch, heading, near, roads) -> tuple[np.ndarray, np.ndarray]:
+def _within(ex, ey, b: _Back, branch, heading, inv: Inverse, segment) -> tuple[np.ndarray, np.ndarray]:
     """The D interval (lo > hi: none) on which branch ``branch[i]``'s point one step back along
-    ``heading[i]`` comes within its reach of the segment ``near[1][i]`` of ``near[0]`` (an
-    :class:`Inverse`) where its centreline's nearest point may lie on that segment
-    (:func:`_nearest_on`), as the hull of that set; with ``near`` None, where it may leave the
-    roads."""
+    ``heading[i]`` comes within its reach of the segment ``segment[i]`` of ``inv`` where its
+    centreline's nearest point may lie on that segment (:func:`_nearest_on`), as the hull of that
+    set; for the rows past ``segment`` (heading 0), where it may leave the roads. One pass over
+    both kinds of rows (the per-step numpy and shapely calls are the dearer part here)."""
     ax = b.ax[branch] + np.sin(heading) / b.steps[branch]
     ay = b.ay[branch] + -np.cos(heading) / b.steps[branch]
     lo, hi = b.lo[branch], b.hi[branch]
     x, y = ex[b.row[branch]], ey[b.row[branch]]
     p = np.stack([x + lo * ax, y + lo * ay], axis=1)
     q = np.stack([x + hi * ax, y + hi * ay], axis=1)
-    if near is None:
-        off = ~shapely.covered_by(shapely.linestrings(np.stack([p, q], axis=1)), roads)
-        return np.where(off, lo, np.inf), np.where(off, hi, -np.inf)
-    inv, segment = near
+    n = len(segment)
+    start, end = np.full(len(p), np.inf), np.full(len(p), -np.inf)
+    off = n + np.flatnonzero(~shapely.covered_by(shapely.linestrings(np.stack([p[n:], q[n:]], axis=1)), inv.roads))
+    start[off], end[off] = lo[off], hi[off]
     ends, reach = inv.ends[segment], inv.reach[segment]
     low = np.minimum(ends[:, :2], ends[:, 2:]) - reach[:, None]
     high = np.maximum(ends[:, :2], ends[:, 2:]) + reach[:, None]
+    p, q = p[:n], q[:n]
     meet = np.flatnonzero(np.all((np.minimum(p, q) <= high) & (np.maximum(p, q) >= low), axis=1))
-    t_lo, t_hi = np.full(len(p), np.inf), np.full(len(p), -np.inf)
-    start, stop, r, s = ends[meet, :2], ends[meet, 2:], (q - p)[meet], segment[meet]
+    t_lo, t_hi = np.full(n, np.inf), np.full(n, -np.inf)
+    a, z, r, s = ends[meet, :2], ends[meet, 2:], (q - p)[meet], segment[meet]
     t_lo[meet], t_hi[meet] = _nearest_on(
         p[meet],
         r,
-        (start, stop),
+        (a, z),
         inv.unit[s],
         (inv.before[s], inv.after[s]),
-        _stadium(p[meet], r, start, stop, reach[meet]),
+        _stadium(p[meet], r, a, z, reach[meet]),
     )
     hit = np.flatnonzero(t_lo <= t_hi)  # elsewhere t_hi may be -inf, and -inf * 0 (a point interval) is NaN
-    start, end = np.full(len(p), np.inf), np.full(len(p), -np.inf)
     start[hit] = lo[hit] + t_lo[hit] * (hi[hit] - lo[hit])
     end[hit] = lo[hit] + t_hi[hit] * (hi[hit] - lo[hit])
     return start, end

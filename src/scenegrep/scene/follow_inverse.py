@@ -420,7 +420,8 @@ def _stadium(p, r, a, b, radius) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _quadratic_below(r, d, radius) -> tuple[np.ndarray, np.ndarray]:
-    """The t in [0, 1] with |d + t r| <= radius, as an interval (low > high: none)."""
+    """The t in [0, 1] with |d + t r| <= radius, as an interval (low > high: none; an empty one
+    may be infinite)."""
     rr = np.einsum("ij,ij->i", r, r)
     dr = np.einsum("ij,ij->i", d, r)
     c = np.einsum("ij,ij->i", d, d) - radius * radius
@@ -430,8 +431,8 @@ def _quadratic_below(r, d, radius) -> tuple[np.ndarray, np.ndarray]:
         root = np.sqrt(np.where(disc >= 0, disc, np.nan))
         low = np.where(moving, (-dr - root) / rr, np.where(c <= 0, 0.0, np.inf))
         high = np.where(moving, (-dr + root) / rr, np.where(c <= 0, 1.0, -np.inf))
-    low, high = np.nan_to_num(low, nan=np.inf), np.nan_to_num(high, nan=-np.inf)
-    return np.maximum(low, 0.0), np.minimum(high, 1.0)
+    none = np.isnan(low) | np.isnan(high)
+    return np.where(none, np.inf, np.maximum(low, 0.0)), np.where(none, -np.inf, np.minimum(high, 1.0))
 
 
 def _linear_within(low, high, f0, f1, bottom, top) -> tuple[np.ndarray, np.ndarray]:

@@ -9,4 +9,6 @@ setup(ext_modules=[Extension("scenegrep.readers._strem", ["src/scenegrep/readers
                    Extension("scenegrep.readers.ros._cdr_copy", ["src/scenegrep/readers/ros/_cdr_copy.c"],
                              extra_compile_args=FLAGS),
                    Extension("scenegrep.readers.ros._cdr_walk", ["src/scenegrep/readers/ros/_cdr_walk.c"],
+                             extra_compile_args=FLAGS),
+                   Extension("scenegrep.readers.ros._place", ["src/scenegrep/readers/ros/_place.c"],
                              extra_compile_args=FLAGS)])

@@ -57,7 +57,8 @@ from .decoders import BOX_TYPES, LINK_TYPES, decode_batch, supported, type_key
 from .messages import Boxes, Coded, DecodeError, ImageBoxes, RawMessage
 from .msgdef import DefinitionError
 from .options import BagOptions
-from .transforms import MissingTransform, TfBuffer, product, rotated, yaw, yaw_of
+from ._place import place
+from .transforms import MissingTransform, TfBuffer, yaw_of
 
 EGO_ID = "ego"
 """The object id of the ego (the pose of ``ego_frame``)."""
@@ -451,31 +452,33 @@ class FrameBuilder:
     def _values(self, seg: _Segment, rows: np.ndarray | slice, out: np.ndarray) -> None:
         """The (9, n) state values of ``rows`` of a segment's boxes (:class:`_Part`), written into
         ``out``: each box moved into the map frame with the transform of its frame id at its stamp,
-        its heading the yaw of its rotation there, its velocity turned by that rotation."""
+        its heading the yaw of its rotation there, its velocity turned by that rotation (one pass
+        of :func:`._place.place` over the boxes, with one transform per frame id and stamp)."""
         boxes: Boxes = seg.boxes  # type: ignore[assignment]
-        xyz, quat, velocity, codes = boxes.xyz[rows], boxes.quat[rows], boxes.velocity[rows], seg.frames[rows]  # type: ignore[index]
-        out[4:7] = boxes.size[rows].T
+        codes = seg.frames[rows]  # type: ignore[index]
         present = np.flatnonzero(np.bincount(codes, minlength=1)).tolist()
+        each, shifts, turns, start = np.empty(len(codes), dtype=np.int64), [], [], 0
         for code in present:
             group = slice(None) if len(present) == 1 else np.flatnonzero(codes == code)
-            position, rotation = tuple(xyz[group].T), tuple(quat[group].T)
-            if code != self.map_code:
-                shift, turn = self._transforms(seg, rows, group, code)
-                position = rotated(turn, position)
-                for moved, by in zip(position, shift):
-                    moved += by
-                rotation = product(turn, rotation)
-            out[0, group], out[1, group], out[2, group] = position
-            out[3, group] = heading_from_yaw(yaw(rotation))
-            out[7, group], out[8, group] = rotated(rotation, tuple(velocity[group].T), axes=2)
+            if code == self.map_code:
+                each[group] = -1
+                continue
+            shift, turn, at = self._transforms(seg, rows, group, code)
+            each[group] = at + start
+            shifts.append(shift)
+            turns.append(turn)
+            start += len(shift)
+        shift = np.concatenate(shifts) if len(shifts) > 1 else shifts[0] if shifts else np.empty((0, 3))
+        turn = np.concatenate(turns) if len(turns) > 1 else turns[0] if turns else np.empty((0, 4))
+        place(boxes.xyz[rows], boxes.quat[rows], boxes.size[rows], boxes.velocity[rows], each, shift, turn, out)
 
     def _transforms(
         self, seg: _Segment, rows: np.ndarray | slice, group: np.ndarray | slice, code: int
-    ) -> tuple[list[np.ndarray], list[np.ndarray]]:
-        """The translation and rotation components (:data:`.transforms.Components`) of frame id
-        ``code`` in the map frame at the stamp of each box of ``group`` of ``rows`` (one lookup per
-        distinct stamp; a stamp without a transform is a :class:`UserError` naming the first
-        box's message without one)."""
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The translations (m, 3) and rotations (m, 4) of frame id ``code`` in the map frame at
+        the distinct stamps of the boxes of ``group`` of ``rows``, and the position of each box's
+        stamp among them (one lookup per distinct stamp; a stamp without a transform is a
+        :class:`UserError` naming the first box's message without one)."""
         boxes: Boxes = seg.boxes  # type: ignore[assignment]
         stamps = boxes.stamp[rows][group]
         distinct, each = _distinct(stamps)
@@ -489,7 +492,7 @@ class FrameBuilder:
                 message = boxes.message[rows][group][exc.row]
                 raise _fail(seg.topic, int(seg.log_times[message]), exc.reason) from None
             raise
-        return [c[each] for c in t.T], [c[each] for c in q.T]
+        return t, q, each
 
     def _ego(self, stamps: np.ndarray) -> np.ndarray | None:
         """The (9, n) state values of the ego at ``stamps`` (:class:`_Part`), or None when the ego

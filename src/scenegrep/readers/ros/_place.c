@@ -1,0 +1,162 @@
+/*
+ * scenegrep.readers.ros._place: the per-box math of framing (framing.py) in one C pass, so no
+ * array is made per operation and each box is read and written once.
+ *
+ * place(xyz, quat, size, velocity, each, shift, turn, out)
+ *     For box i of n: position xyz[i] (n, 3), rotation quat[i] (n, 4; x, y, z, w), size[i]
+ *     (n, 3) and velocity velocity[i] (n, 3), all float64 with any strides. each[i] (int64) is
+ *     the row of its transform into the map frame in shift (m, 3) and turn (m, 4; a unit
+ *     quaternion), or -1 when the box is in the map frame already. Writes out[:, i] of out
+ *     (9, n; float64, any strides): x, y, z (turn applied to xyz, then shift added), heading
+ *     (the Scenic heading of the yaw of turn * quat), length, width, height (size as is), vx,
+ *     vy (velocity turned by turn * quat). The formulas and their order of operations are those
+ *     of transforms.py (product, rotated, yaw) and model.geometry.heading_from_yaw, so the
+ *     results are theirs. Shapes, dtypes and every index of `each` are checked before anything
+ *     is written (ValueError otherwise).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <math.h>
+#include <stdint.h>
+
+#define PI 3.141592653589793
+#define TWO_PI (2.0 * PI)
+
+typedef struct {
+    Py_buffer view;
+    const char *name;
+} Array;
+
+/* A float64 (or int64 when `integer`) buffer of `ndim` dimensions, the last of `columns` entries
+ * (0: any), writable when asked. */
+static int get(PyObject *obj, Array *a, const char *name, int ndim, Py_ssize_t columns, int writable, int integer) {
+    a->name = name;
+    int flags = PyBUF_RECORDS_RO | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, &a->view, flags) < 0) {
+        a->view.obj = NULL;
+        return -1;
+    }
+    const char *format = a->view.format ? a->view.format : "";
+    if (format[0] == '<' || format[0] == '=' || format[0] == '@') format++; /* (x86-64 and arm64: little-endian) */
+    int ok = a->view.ndim == ndim && a->view.itemsize == 8 &&
+             (integer ? (format[0] == 'l' || format[0] == 'q') && format[1] == 0
+                      : format[0] == 'd' && format[1] == 0) &&
+             (columns == 0 || a->view.shape[ndim - 1] == columns);
+    if (!ok) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %d-d %s array%s", name, ndim, integer ? "int64" : "float64",
+                     columns == 3 ? " of 3 columns" : (columns == 4 ? " of 4 columns" : ""));
+        PyBuffer_Release(&a->view);
+        a->view.obj = NULL;
+        return -1;
+    }
+    return 0;
+}
+
+static inline double at(const Array *a, Py_ssize_t i, Py_ssize_t j) {
+    return *(const double *)((const char *)a->view.buf + i * a->view.strides[0] + j * a->view.strides[1]);
+}
+
+/* The Scenic heading of a yaw: normalize_angle(yaw - pi / 2) = pi - mod(pi - a, 2 pi), with
+ * numpy's floating mod (the sign of the divisor). */
+static inline double heading_from_yaw(double yaw) {
+    double a = PI - (yaw - PI / 2);
+    double m = fmod(a, TWO_PI);
+    if (m != 0) {
+        if ((m < 0) != (TWO_PI < 0)) m += TWO_PI;
+    } else {
+        m = copysign(0.0, TWO_PI);
+    }
+    return PI - m;
+}
+
+/* v rotated by the unit quaternion (ux, uy, uz, w): v + w t + u x t with t = 2 (u x v). */
+static inline void rotate(const double q[4], const double v[3], double r[3]) {
+    double ux = q[0], uy = q[1], uz = q[2], w = q[3];
+    double tx = (uy * v[2] - uz * v[1]) * 2.0;
+    double ty = (uz * v[0] - ux * v[2]) * 2.0;
+    double tz = (ux * v[1] - uy * v[0]) * 2.0;
+    r[0] = (w * tx + v[0]) + (uy * tz - uz * ty);
+    r[1] = (w * ty + v[1]) + (uz * tx - ux * tz);
+    r[2] = (w * tz + v[2]) + (ux * ty - uy * tx);
+}
+
+/* The Hamilton product a * b. */
+static inline void product(const double a[4], const double b[4], double r[4]) {
+    double ax = a[0], ay = a[1], az = a[2], aw = a[3], bx = b[0], by = b[1], bz = b[2], bw = b[3];
+    r[0] = aw * bx + ax * bw + ay * bz - az * by;
+    r[1] = aw * by - ax * bz + ay * bw + az * bx;
+    r[2] = aw * bz + ax * by - ay * bx + az * bw;
+    r[3] = aw * bw - ax * bx - ay * by - az * bz;
+}
+
+static PyObject *place(PyObject *self, PyObject *args) {
+    (void)self;
+    PyObject *objs[8];
+    if (!PyArg_ParseTuple(args, "OOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6],
+                          &objs[7]))
+        return NULL;
+    Array xyz, quat, size, velocity, each, shift, turn, out;
+    Array *all[8] = {&xyz, &quat, &size, &velocity, &each, &shift, &turn, &out};
+    for (int k = 0; k < 8; k++) all[k]->view.obj = NULL;
+    PyObject *result = NULL;
+    if (get(objs[0], &xyz, "xyz", 2, 3, 0, 0) < 0 || get(objs[1], &quat, "quat", 2, 4, 0, 0) < 0 ||
+        get(objs[2], &size, "size", 2, 3, 0, 0) < 0 || get(objs[3], &velocity, "velocity", 2, 3, 0, 0) < 0 ||
+        get(objs[4], &each, "each", 1, 0, 0, 1) < 0 || get(objs[5], &shift, "shift", 2, 3, 0, 0) < 0 ||
+        get(objs[6], &turn, "turn", 2, 4, 0, 0) < 0 || get(objs[7], &out, "out", 2, 0, 1, 0) < 0)
+        goto done;
+    Py_ssize_t n = xyz.view.shape[0], m = shift.view.shape[0];
+    if (quat.view.shape[0] != n || size.view.shape[0] != n || velocity.view.shape[0] != n ||
+        each.view.shape[0] != n || out.view.shape[0] != 9 || out.view.shape[1] != n || turn.view.shape[0] != m) {
+        PyErr_SetString(PyExc_ValueError, "place: arrays of different lengths (or out not (9, n))");
+        goto done;
+    }
+    const char *each_buf = each.view.buf;
+    Py_ssize_t each_stride = each.view.strides[0];
+    for (Py_ssize_t i = 0; i < n; i++) {
+        int64_t e = *(const int64_t *)(each_buf + i * each_stride);
+        if (e < -1 || e >= m) {
+            PyErr_Format(PyExc_ValueError, "place: each[%zd] = %lld is not a transform row", i, (long long)e);
+            goto done;
+        }
+    }
+    char *o = out.view.buf;
+    Py_ssize_t os0 = out.view.strides[0], os1 = out.view.strides[1];
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n; i++) {
+        int64_t e = *(const int64_t *)(each_buf + i * each_stride);
+        double p[3] = {at(&xyz, i, 0), at(&xyz, i, 1), at(&xyz, i, 2)};
+        double q[4] = {at(&quat, i, 0), at(&quat, i, 1), at(&quat, i, 2), at(&quat, i, 3)};
+        double v[3] = {at(&velocity, i, 0), at(&velocity, i, 1), at(&velocity, i, 2)};
+        double position[3], rotation[4], moved[3];
+        if (e >= 0) {
+            double t[4] = {at(&turn, e, 0), at(&turn, e, 1), at(&turn, e, 2), at(&turn, e, 3)};
+            rotate(t, p, position);
+            for (int k = 0; k < 3; k++) position[k] += at(&shift, e, k);
+            product(t, q, rotation);
+        } else {
+            for (int k = 0; k < 3; k++) position[k] = p[k];
+            for (int k = 0; k < 4; k++) rotation[k] = q[k];
+        }
+        double x = rotation[0], y = rotation[1], z = rotation[2], w = rotation[3];
+        double sine = (w * z + x * y) * 2.0, cosine = (y * y + z * z) * 2.0;
+        rotate(rotation, v, moved);
+        double values[9] = {position[0], position[1], position[2], heading_from_yaw(atan2(sine, 1.0 - cosine)),
+                            at(&size, i, 0), at(&size, i, 1), at(&size, i, 2), moved[0], moved[1]};
+        for (int k = 0; k < 9; k++) *(double *)(o + k * os0 + i * os1) = values[k];
+    }
+    Py_END_ALLOW_THREADS
+    result = Py_NewRef(Py_None);
+done:
+    for (int k = 0; k < 8; k++)
+        if (all[k]->view.obj) PyBuffer_Release(&all[k]->view);
+    return result;
+}
+
+static PyMethodDef methods[] = {
+    {"place", place, METH_VARARGS, "place(xyz, quat, size, velocity, each, shift, turn, out): see the module comment"},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_place", NULL, -1, methods, NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__place(void) { return PyModule_Create(&module); }

@@ -48,23 +48,33 @@ def _reference(b: dict[str, np.ndarray]) -> np.ndarray:
     return np.vstack([position, heading_from_yaw(yaw(rotation)), b["size"].T, velocity])
 
 
+ARGUMENTS = ("xyz", "quat", "size", "velocity", "each", "shift", "turn", "dest", "out")
+
+
 def test_place_is_the_numpy_formulas_on_strided_arrays(boxes):
-    grid = np.full((9, 3 * N), -7.0)
-    out = grid[:, ::3]  # (a strided output: every third column)
-    place(
-        boxes["xyz"], boxes["quat"], boxes["size"], boxes["velocity"], boxes["each"], boxes["shift"], boxes["turn"], out
-    )
+    rng = np.random.default_rng(5)
+    dest = rng.permutation(2 * N)[:N]  # (rows of a longer output, in any order)
+    dest[::7] = -1  # (not written)
+    grid = np.full((9, 3 * 2 * N), -7.0)
+    out = list(grid[:, ::3])  # (strided outputs: every third row of a (9, .) array)
+    place(*(boxes[k] for k in ARGUMENTS[:7]), dest, out)
     expected = _reference(boxes)
-    np.testing.assert_array_equal(np.isnan(out), np.isnan(expected))
-    assert np.nanmax(np.abs(out - expected)) < 1e-9  # (positions up to ~1e3 m: the last bits may differ in atan2)
-    assert (grid[:, 1::3] == -7.0).all() and (grid[:, 2::3] == -7.0).all()  # nothing written beside
-    still = boxes["each"] == -1
-    np.testing.assert_array_equal(out[:3, still], boxes["xyz"][still].T)  # (the map frame's boxes as they are)
+    written = dest >= 0
+    got = grid[:, ::3][:, dest[written]]
+    np.testing.assert_array_equal(np.isnan(got), np.isnan(expected[:, written]))
+    assert np.nanmax(np.abs(got - expected[:, written])) < 1e-9  # (positions up to ~1e3 m; atan2's last bit)
+    untouched = np.ones(3 * 2 * N, dtype=bool)
+    untouched[3 * dest[written]] = False
+    assert (grid[:, untouched] == -7.0).all()  # (nothing written elsewhere)
+    still = written & (boxes["each"] == -1)
+    np.testing.assert_array_equal(grid[:3, ::3][:, dest[still]], boxes["xyz"][still].T)  # (the map frame's as is)
 
 
 def test_place_of_no_boxes_writes_nothing():
-    empty3, empty4 = np.empty((0, 3)), np.empty((0, 4))
-    place(empty3, empty4, empty3, empty3, np.empty(0, dtype=np.int64), empty3, empty4, np.empty((9, 0)))
+    empty3, empty4, none = np.empty((0, 3)), np.empty((0, 4)), np.empty(0, dtype=np.int64)
+    out = [np.zeros(3) for _ in range(9)]
+    place(empty3, empty4, empty3, empty3, none, empty3, empty4, none, out)
+    assert not np.any(out)
 
 
 @pytest.mark.parametrize(
@@ -72,23 +82,26 @@ def test_place_of_no_boxes_writes_nothing():
     [
         ({"each": np.full(N, M)}, "not a transform row"),
         ({"each": np.full(N, -2)}, "not a transform row"),
+        ({"dest": np.full(N, N)}, "not a row of out"),
+        ({"dest": np.full(N, -2)}, "not a row of out"),
         ({"each": np.zeros(N, dtype=np.int32)}, "int64"),
         ({"xyz": np.zeros((N, 2))}, "xyz"),
         ({"quat": np.zeros((N, 4), dtype=np.float32)}, "quat"),
         ({"size": np.zeros((N - 1, 3))}, "different lengths"),
         ({"turn": np.zeros((M + 1, 4))}, "different lengths"),
-        ({"out": np.zeros((8, N))}, "different lengths"),
+        ({"out": [np.zeros(N)] * 8}, "9 arrays"),
+        ({"out": [np.zeros(N)] * 8 + [np.zeros(N - 1)]}, "different lengths"),
+        ({"out": [np.zeros(N)] * 8 + [np.zeros((N, 1))]}, "out vy"),
     ],
 )
 def test_place_refuses_what_it_cannot_use(boxes, change, message):
-    arguments = {**boxes, "out": np.zeros((9, N)), **change}
-    names = ("xyz", "quat", "size", "velocity", "each", "shift", "turn", "out")
+    arguments = {**boxes, "dest": np.arange(N), "out": [np.zeros(N) for _ in range(9)], **change}
     with pytest.raises(ValueError, match=message):
-        place(*(arguments[k] for k in names))
+        place(*(arguments[k] for k in ARGUMENTS))
 
 
 def test_place_refuses_a_read_only_output(boxes):
-    out = np.zeros((9, N))
-    out.flags.writeable = False
+    out = [np.zeros(N) for _ in range(9)]
+    out[4].flags.writeable = False
     with pytest.raises((ValueError, BufferError)):
-        place(*(boxes[k] for k in ("xyz", "quat", "size", "velocity", "each", "shift", "turn")), out)
+        place(*(boxes[k] for k in ARGUMENTS[:7]), np.arange(N), out)

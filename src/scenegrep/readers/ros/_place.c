@@ -2,17 +2,19 @@
  * scenegrep.readers.ros._place: the per-box math of framing (framing.py) in one C pass, so no
  * array is made per operation and each box is read and written once.
  *
- * place(xyz, quat, size, velocity, each, shift, turn, out)
+ * place(xyz, quat, size, velocity, each, shift, turn, dest, out)
  *     For box i of n: position xyz[i] (n, 3), rotation quat[i] (n, 4; x, y, z, w), size[i]
  *     (n, 3) and velocity velocity[i] (n, 3), all float64 with any strides. each[i] (int64) is
  *     the row of its transform into the map frame in shift (m, 3) and turn (m, 4; a unit
- *     quaternion), or -1 when the box is in the map frame already. Writes out[:, i] of out
- *     (9, n; float64, any strides): x, y, z (turn applied to xyz, then shift added), heading
- *     (the Scenic heading of the yaw of turn * quat), length, width, height (size as is), vx,
- *     vy (velocity turned by turn * quat). The formulas and their order of operations are those
- *     of transforms.py (product, rotated, yaw) and model.geometry.heading_from_yaw, so the
- *     results are theirs. Shapes, dtypes and every index of `each` are checked before anything
- *     is written (ValueError otherwise).
+ *     quaternion), or -1 when the box is in the map frame already. dest[i] (int64) is the row
+ *     the box is written to in out, or -1 when it is not written. out is a sequence of 9
+ *     float64 arrays (1-d, any stride, one length) that get, at row dest[i]: x, y, z (turn
+ *     applied to xyz, then shift added), heading (the Scenic heading of the yaw of turn *
+ *     quat), length, width, height (size as is), vx, vy (velocity turned by turn * quat). The
+ *     formulas and their order of operations are those of transforms.py (product, rotated,
+ *     yaw) and model.geometry.heading_from_yaw, so the results are theirs (atan2 may differ
+ *     from numpy's in the last bit). Shapes, dtypes and every index of `each` and `dest` are
+ *     checked before anything is written (ValueError otherwise).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -57,14 +59,22 @@ static inline double at(const Array *a, Py_ssize_t i, Py_ssize_t j) {
 }
 
 /* The Scenic heading of a yaw: normalize_angle(yaw - pi / 2) = pi - mod(pi - a, 2 pi), with
- * numpy's floating mod (the sign of the divisor). */
+ * numpy's floating mod (the sign of the divisor). For a yaw of atan2 (in [-pi, pi]) the
+ * argument lies in [pi / 2, 5 pi / 2], where that mod is one exact subtraction (Sterbenz), so
+ * fmod runs only for other values. */
 static inline double heading_from_yaw(double yaw) {
-    double a = PI - (yaw - PI / 2);
-    double m = fmod(a, TWO_PI);
-    if (m != 0) {
-        if ((m < 0) != (TWO_PI < 0)) m += TWO_PI;
+    double a = PI - (yaw - PI / 2), m;
+    if (a >= 0 && a < TWO_PI) {
+        m = a == 0 ? 0.0 : a;
+    } else if (a >= TWO_PI && a <= 2 * TWO_PI) {
+        m = a - TWO_PI;
     } else {
-        m = copysign(0.0, TWO_PI);
+        m = fmod(a, TWO_PI);
+        if (m != 0) {
+            if (m < 0) m += TWO_PI;
+        } else {
+            m = 0.0;
+        }
     }
     return PI - m;
 }
@@ -91,39 +101,61 @@ static inline void product(const double a[4], const double b[4], double r[4]) {
 
 static PyObject *place(PyObject *self, PyObject *args) {
     (void)self;
-    PyObject *objs[8];
-    if (!PyArg_ParseTuple(args, "OOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6],
-                          &objs[7]))
+    PyObject *objs[9];
+    if (!PyArg_ParseTuple(args, "OOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6],
+                          &objs[7], &objs[8]))
         return NULL;
-    Array xyz, quat, size, velocity, each, shift, turn, out;
-    Array *all[8] = {&xyz, &quat, &size, &velocity, &each, &shift, &turn, &out};
-    for (int k = 0; k < 8; k++) all[k]->view.obj = NULL;
-    PyObject *result = NULL;
+    Array xyz, quat, size, velocity, each, shift, turn, dest, out[9];
+    Array *all[17] = {&xyz, &quat, &size, &velocity, &each, &shift, &turn, &dest};
+    for (int k = 0; k < 9; k++) all[8 + k] = &out[k];
+    for (int k = 0; k < 17; k++) all[k]->view.obj = NULL;
+    PyObject *result = NULL, *columns = NULL;
+    static const char *names[9] = {"out x", "out y", "out z", "out heading", "out length", "out width", "out height",
+                                   "out vx", "out vy"};
     if (get(objs[0], &xyz, "xyz", 2, 3, 0, 0) < 0 || get(objs[1], &quat, "quat", 2, 4, 0, 0) < 0 ||
         get(objs[2], &size, "size", 2, 3, 0, 0) < 0 || get(objs[3], &velocity, "velocity", 2, 3, 0, 0) < 0 ||
         get(objs[4], &each, "each", 1, 0, 0, 1) < 0 || get(objs[5], &shift, "shift", 2, 3, 0, 0) < 0 ||
-        get(objs[6], &turn, "turn", 2, 4, 0, 0) < 0 || get(objs[7], &out, "out", 2, 0, 1, 0) < 0)
+        get(objs[6], &turn, "turn", 2, 4, 0, 0) < 0 || get(objs[7], &dest, "dest", 1, 0, 0, 1) < 0)
         goto done;
-    Py_ssize_t n = xyz.view.shape[0], m = shift.view.shape[0];
-    if (quat.view.shape[0] != n || size.view.shape[0] != n || velocity.view.shape[0] != n ||
-        each.view.shape[0] != n || out.view.shape[0] != 9 || out.view.shape[1] != n || turn.view.shape[0] != m) {
-        PyErr_SetString(PyExc_ValueError, "place: arrays of different lengths (or out not (9, n))");
+    columns = PySequence_Fast(objs[8], "out must be a sequence of 9 arrays");
+    if (!columns) goto done;
+    if (PySequence_Fast_GET_SIZE(columns) != 9) {
+        PyErr_SetString(PyExc_ValueError, "out must be a sequence of 9 arrays");
         goto done;
     }
-    const char *each_buf = each.view.buf;
-    Py_ssize_t each_stride = each.view.strides[0];
+    for (int k = 0; k < 9; k++)
+        if (get(PySequence_Fast_GET_ITEM(columns, k), &out[k], names[k], 1, 0, 1, 0) < 0) goto done;
+    Py_ssize_t n = xyz.view.shape[0], m = shift.view.shape[0], rows = out[0].view.shape[0];
+    int same = 1;
+    for (int k = 1; k < 9; k++) same &= out[k].view.shape[0] == rows;
+    if (quat.view.shape[0] != n || size.view.shape[0] != n || velocity.view.shape[0] != n ||
+        each.view.shape[0] != n || dest.view.shape[0] != n || turn.view.shape[0] != m || !same) {
+        PyErr_SetString(PyExc_ValueError, "place: arrays of different lengths");
+        goto done;
+    }
+    const char *each_buf = each.view.buf, *dest_buf = dest.view.buf;
+    Py_ssize_t each_stride = each.view.strides[0], dest_stride = dest.view.strides[0];
     for (Py_ssize_t i = 0; i < n; i++) {
-        int64_t e = *(const int64_t *)(each_buf + i * each_stride);
+        int64_t e = *(const int64_t *)(each_buf + i * each_stride), d = *(const int64_t *)(dest_buf + i * dest_stride);
         if (e < -1 || e >= m) {
             PyErr_Format(PyExc_ValueError, "place: each[%zd] = %lld is not a transform row", i, (long long)e);
             goto done;
         }
+        if (d < -1 || d >= rows) {
+            PyErr_Format(PyExc_ValueError, "place: dest[%zd] = %lld is not a row of out", i, (long long)d);
+            goto done;
+        }
     }
-    char *o = out.view.buf;
-    Py_ssize_t os0 = out.view.strides[0], os1 = out.view.strides[1];
+    char *o[9];
+    Py_ssize_t os[9];
+    for (int k = 0; k < 9; k++) {
+        o[k] = out[k].view.buf;
+        os[k] = out[k].view.strides[0];
+    }
     Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t i = 0; i < n; i++) {
-        int64_t e = *(const int64_t *)(each_buf + i * each_stride);
+        int64_t e = *(const int64_t *)(each_buf + i * each_stride), d = *(const int64_t *)(dest_buf + i * dest_stride);
+        if (d < 0) continue;
         double p[3] = {at(&xyz, i, 0), at(&xyz, i, 1), at(&xyz, i, 2)};
         double q[4] = {at(&quat, i, 0), at(&quat, i, 1), at(&quat, i, 2), at(&quat, i, 3)};
         double v[3] = {at(&velocity, i, 0), at(&velocity, i, 1), at(&velocity, i, 2)};
@@ -142,18 +174,19 @@ static PyObject *place(PyObject *self, PyObject *args) {
         rotate(rotation, v, moved);
         double values[9] = {position[0], position[1], position[2], heading_from_yaw(atan2(sine, 1.0 - cosine)),
                             at(&size, i, 0), at(&size, i, 1), at(&size, i, 2), moved[0], moved[1]};
-        for (int k = 0; k < 9; k++) *(double *)(o + k * os0 + i * os1) = values[k];
+        for (int k = 0; k < 9; k++) *(double *)(o[k] + d * os[k]) = values[k];
     }
     Py_END_ALLOW_THREADS
     result = Py_NewRef(Py_None);
 done:
-    for (int k = 0; k < 8; k++)
+    for (int k = 0; k < 17; k++)
         if (all[k]->view.obj) PyBuffer_Release(&all[k]->view);
+    Py_XDECREF(columns);
     return result;
 }
 
 static PyMethodDef methods[] = {
-    {"place", place, METH_VARARGS, "place(xyz, quat, size, velocity, each, shift, turn, out): see the module comment"},
+    {"place", place, METH_VARARGS, "place(xyz, quat, size, velocity, each, shift, turn, dest, out): see the module comment"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -52,12 +52,14 @@ from ...errors import UserError
 from ...model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
 from ...model.geometry import heading_from_yaw
 from ...model.images import concatenate_layers
+from ...model.states import FLOAT_COLUMNS
 from ...model.trace import EGO_SIZE_UNKNOWN
 from .decoders import BOX_TYPES, LINK_TYPES, decode_batch, supported, type_key
 from .messages import Boxes, Coded, DecodeError, ImageBoxes, RawMessage
 from .msgdef import DefinitionError
 from .options import BagOptions
 from ._place import place
+from .columns import Column
 from .transforms import MissingTransform, TfBuffer, yaw_of
 
 EGO_ID = "ego"
@@ -130,25 +132,33 @@ class _Segment:
         return chosen[self.boxes.message]
 
 
-@dataclass
-class _Part:
-    """The frames one emission completed, before they become a trace: their ``stamps`` (ns),
-    ``times`` (s from the origin), and per row (in frame order, topics in pick order, the ego
-    last): its ``frame`` (position among these frames) and the builder's code of its object id
-    (``ids``; int32), and ``values`` (9, n): x, y, z, heading, length, width, height, vx, vy. Per
-    object id it holds (``seen``, any order): its ``first`` row and that row's class code
-    (``first_class``)."""
+class _Rows:
+    """The rows of one trace as its frames are emitted (the offline run's whole bag, or one
+    chunk of :meth:`FrameBuilder.feed`): the state columns, growing (:class:`.columns.Column`;
+    rows in (frame, object) order, frames numbered from 0), the frames' ``stamps`` (ns) and
+    ``times`` (s from the origin), their images, and the objects numbered in order of first
+    appearance: ``number`` (per builder code of an object id; -1 not yet seen), ``objects`` (the
+    codes in number order) and ``category`` (the class code of each at its first row)."""
 
-    stamps: np.ndarray
-    times: np.ndarray
-    frame: np.ndarray
-    ids: np.ndarray
-    values: np.ndarray
-    seen: np.ndarray
-    first: np.ndarray
-    first_class: np.ndarray
-    has_ego: bool
-    images: ImageLayer | None
+    def __init__(self, codes: int) -> None:
+        self.frame = Column(np.int32)
+        self.object = Column(np.int32)
+        self.values = [Column(np.float64) for _ in FLOAT_COLUMNS]
+        self.size = 0
+        self.frames = 0
+        self.number = np.full(max(codes, 1), -1, dtype=np.int32)
+        self.objects: list[int] = []
+        self.category: list[int] = []
+        self.stamps: list[np.ndarray] = []
+        self.times: list[np.ndarray] = []
+        self.images: list[tuple[ImageLayer | None, int]] = []
+        self.has_ego: bool | None = None
+
+    def numbers(self, codes: int) -> np.ndarray:
+        """``number``, grown to hold ``codes`` builder codes."""
+        if len(self.number) < codes:
+            self.number = np.concatenate([self.number, np.full(2 * codes - len(self.number), -1, dtype=np.int32)])
+        return self.number
 
 
 def _fail(topic: str, log_time: int, reason: str) -> UserError:
@@ -185,39 +195,41 @@ class FrameBuilder:
     # ------------------------------------------------------------------ input
     def feed(self, batch: Sequence[RawMessage]) -> LabelTrace | None:
         """Take a batch of messages; the frames it completed, or None."""
-        part = self._feed(batch)
-        return None if part is None else self._trace([part])
+        rows = _Rows(len(self.ids))
+        self._feed(batch, rows)
+        return self._trace(rows)
 
     def finish(self) -> LabelTrace | None:
         """The frames left at the end of input; notes unknown topics and late messages on stderr."""
-        part = self._finish()
-        return None if part is None else self._trace([part])
+        rows = _Rows(len(self.ids))
+        self._finish(rows)
+        return self._trace(rows)
 
     def run(self, batches: Iterable[Sequence[RawMessage]]) -> LabelTrace | None:
         """Feed every batch and finish: all the frames as one trace (the chunks :meth:`feed` and
-        :meth:`finish` would give, concatenated), or None when no frame was built. Each batch's
-        frames are kept as codes and arrays; the trace is made once, at the end."""
-        parts = [part for batch in batches if (part := self._feed(batch)) is not None]
-        last = self._finish()
-        parts += [last] if last is not None else []
-        return self._trace(parts) if parts else None
+        :meth:`finish` would give, concatenated), or None when no frame was built. The frames'
+        rows are written into one set of growing columns; the trace is made once, at the end."""
+        rows = _Rows(len(self.ids))
+        for batch in batches:
+            self._feed(batch, rows)
+        self._finish(rows)
+        return self._trace(rows)
 
-    def _feed(self, batch: Sequence[RawMessage]) -> _Part | None:
+    def _feed(self, batch: Sequence[RawMessage], rows: _Rows) -> None:
         by_topic: dict[str, list[RawMessage]] = {}
         for message in batch:
             by_topic.setdefault(message.topic, []).append(message)
         for topic, messages in by_topic.items():
             self._topic(topic, messages)
-        return self._emit(final=False)
+        self._emit(False, rows)
 
-    def _finish(self) -> _Part | None:
-        part = self._emit(final=True)
+    def _finish(self, rows: _Rows) -> None:
+        self._emit(True, rows)
         if self.skipped:
             listed = ", ".join(f"{t} ({k})" for t, k in self.skipped.items())
             self.note(f"skipped topics of unsupported types: {listed}")
         if self.late:
             self.note(f"{self.late} box messages arrived after their frame was built and were dropped")
-        return part
 
     def _topic(self, topic: str, messages: list[RawMessage]) -> None:
         first = messages[0]
@@ -370,23 +382,25 @@ class FrameBuilder:
             ready -= 1
         return 0, []
 
-    def _emit(self, final: bool) -> _Part | None:
+    def _emit(self, final: bool, rows: _Rows) -> None:
+        """Add the frames now complete and ready to ``rows``."""
         stamps = self._candidates(final)
         ready, picks = self._ready(stamps, final)
         stamps = stamps[:ready]
         if not len(stamps):
-            return None
-        part = self._part(stamps, picks)
+            return
+        self._part(stamps, picks, rows)
         self.last_stamp = int(stamps[-1])
         horizon = self.last_stamp + (self._period() - 1 if self.options.rate is not None else 0)
         for segment in self.segments:
             segment.alive &= segment.stamps > horizon
         self.segments = [s for s in self.segments if s.alive.any()]
-        return part
 
     # ------------------------------------------------------------------ building
-    def _part(self, stamps: np.ndarray, picks: list) -> _Part:
-        """The rows of the frames at ``stamps`` from their picks (:meth:`_messages`) and the ego."""
+    def _part(self, stamps: np.ndarray, picks: list, out: _Rows) -> None:
+        """Add the frames at ``stamps`` to ``out``: the rows of their picks (:meth:`_messages`)
+        and the ego's, in (frame, object) order (in a frame, of the rows of one object the first
+        in pick order, the ego last), objects numbered in order of first appearance."""
         if self.origin is None:
             self.origin = int(stamps[0])
         images = _image_layer([p for p in picks if p[0].frames is None])
@@ -404,39 +418,61 @@ class FrameBuilder:
             classes.append(seg.classes[rows])  # type: ignore[index]
             objects.append(seg.objects)
             taken.append((seg, rows))
-        values_all, start = np.empty((9, sum(map(len, frame)) + len(stamps))), 0
-        for (seg, rows), rows_frame in zip(taken, frame):  # (the boxes first: their errors come first)
-            self._values(seg, rows, values_all[:, start : start + len(rows_frame)])
-            start += len(rows_frame)
-        ego = self._ego(stamps)
-        if ego is not None:
+        has_ego = self.tf.chain(self.options.ego_frame, self.options.map_frame) not in (None, [])
+        if has_ego:
             frame.append(np.arange(len(stamps), dtype=np.int32))
             ids.append(np.full(len(stamps), self.ids.code(EGO_ID), dtype=np.int32))
             classes.append(np.full(len(stamps), self.classes.code(EGO_ID), dtype=np.int32))
             objects.append(ids[-1][:1])
-            values_all[:, start:] = ego
-        else:
-            values_all = values_all[:, :start]
         frame_all, ids_all, classes_all = (
             np.concatenate(c) if c else np.empty(0, np.int32) for c in (frame, ids, classes)
         )
-        if not (frame_all[1:] >= frame_all[:-1]).all():
-            by_frame = np.argsort(frame_all, kind="stable")
-            frame_all, ids_all, classes_all = frame_all[by_frame], ids_all[by_frame], classes_all[by_frame]
-            values_all = np.take(values_all, by_frame, axis=1)
-        seen, first = self._first_rows(ids_all, np.unique(np.concatenate(objects)) if objects else ids_all)
-        return _Part(
-            stamps,
-            (stamps - self.origin) / 1e9,
-            frame_all,
-            ids_all,
-            values_all,
-            seen,
-            first,
-            classes_all[first],
-            ego is not None,
-            images,
-        )
+        dest, kept = self._placement(frame_all, ids_all, classes_all, objects, out)
+        start, columns = out.size, [c.rows(out.size, out.size + len(kept)) for c in out.values]
+        offset = 0
+        for (seg, rows), rows_frame in zip(taken, frame):  # (the boxes first: their errors come first)
+            self._values(seg, rows, dest[offset : offset + len(rows_frame)], columns)
+            offset += len(rows_frame)
+        if has_ego:
+            ego, at = self._ego(stamps), dest[offset:]
+            for column, values in zip(columns, ego):
+                column[at[at >= 0]] = values[at >= 0]
+        out.frame.rows(start, start + len(kept))[:] = frame_all[kept] + out.frames
+        out.object.rows(start, start + len(kept))[:] = out.number[ids_all[kept]]
+        out.size += len(kept)
+        out.images.append((images, out.frames))
+        out.stamps.append(stamps)
+        out.times.append((stamps - self.origin) / 1e9)
+        out.frames += len(stamps)
+        out.has_ego = has_ego if out.has_ego is None else out.has_ego
+
+    def _placement(
+        self, frame: np.ndarray, ids: np.ndarray, classes: np.ndarray, objects: list[np.ndarray], out: _Rows
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """For rows of frames (positions among the new frames), object ids and classes (builder
+        codes), in pick order: the row of ``out``'s columns each is written to, relative to the
+        rows it holds (-1: a repeat of its object in its frame, dropped), and the rows kept in
+        the order they are written. The objects first seen here are numbered in ``out`` (in
+        order of first appearance: by frame, then pick order)."""
+        by_frame = None if (frame[1:] >= frame[:-1]).all() else np.argsort(frame, kind="stable")
+        in_frames = ids if by_frame is None else ids[by_frame]
+        number = out.numbers(len(self.ids))
+        candidates = np.unique(np.concatenate(objects)) if objects else in_frames
+        seen, first = self._first_rows(in_frames, candidates[number[candidates] < 0])
+        if len(seen):
+            order = np.argsort(first, kind="stable")
+            number[seen[order]] = np.arange(len(out.objects), len(out.objects) + len(seen), dtype=np.int32)
+            out.objects += seen[order].tolist()
+            first_class = classes[first[order]] if by_frame is None else classes[by_frame[first[order]]]
+            out.category += first_class.tolist()
+        kept = np.arange(len(frame)) if by_frame is None else by_frame
+        key = frame[kept].astype(np.int64) * max(len(out.objects), 1) + number[ids[kept]]
+        if not (key[1:] > key[:-1]).all():  # an object twice in a frame, or objects out of order
+            order = np.argsort(key, kind="stable")
+            kept = kept[order[np.r_[True, key[order][1:] != key[order][:-1]]]]
+        dest = np.full(len(frame), -1, dtype=np.int64)
+        dest[kept] = np.arange(len(kept))
+        return dest, kept
 
     def _first_rows(self, ids: np.ndarray, candidates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The codes among ``candidates`` that ``ids`` holds, and the first row of each (no sort:
@@ -449,11 +485,12 @@ class FrameBuilder:
         present = first < len(ids)
         return candidates[present], first[present]
 
-    def _values(self, seg: _Segment, rows: np.ndarray | slice, out: np.ndarray) -> None:
-        """The (9, n) state values of ``rows`` of a segment's boxes (:class:`_Part`), written into
-        ``out``: each box moved into the map frame with the transform of its frame id at its stamp,
-        its heading the yaw of its rotation there, its velocity turned by that rotation (one pass
-        of :func:`._place.place` over the boxes, with one transform per frame id and stamp)."""
+    def _values(self, seg: _Segment, rows: np.ndarray | slice, dest: np.ndarray, columns: list[np.ndarray]) -> None:
+        """Write the state values of ``rows`` of a segment's boxes into the state ``columns``
+        (:data:`~scenegrep.model.states.FLOAT_COLUMNS`) at rows ``dest`` (-1: not written):
+        each box moved into the map frame with the transform of its frame id at its stamp, its
+        heading the yaw of its rotation there, its velocity turned by that rotation (one pass of
+        :func:`._place.place` over the boxes, with one transform per frame id and stamp)."""
         boxes: Boxes = seg.boxes  # type: ignore[assignment]
         codes = seg.frames[rows]  # type: ignore[index]
         present = np.flatnonzero(np.bincount(codes, minlength=1)).tolist()
@@ -470,7 +507,8 @@ class FrameBuilder:
             start += len(shift)
         shift = np.concatenate(shifts) if len(shifts) > 1 else shifts[0] if shifts else np.empty((0, 3))
         turn = np.concatenate(turns) if len(turns) > 1 else turns[0] if turns else np.empty((0, 4))
-        place(boxes.xyz[rows], boxes.quat[rows], boxes.size[rows], boxes.velocity[rows], each, shift, turn, out)
+        xyz, quat, size, velocity = boxes.xyz[rows], boxes.quat[rows], boxes.size[rows], boxes.velocity[rows]
+        place(xyz, quat, size, velocity, each, shift, turn, dest, columns)
 
     def _transforms(
         self, seg: _Segment, rows: np.ndarray | slice, group: np.ndarray | slice, code: int
@@ -494,11 +532,9 @@ class FrameBuilder:
             raise
         return t, q, each
 
-    def _ego(self, stamps: np.ndarray) -> np.ndarray | None:
-        """The (9, n) state values of the ego at ``stamps`` (:class:`_Part`), or None when the ego
-        frame does not reach the map frame."""
-        if self.tf.chain(self.options.ego_frame, self.options.map_frame) in (None, []):
-            return None
+    def _ego(self, stamps: np.ndarray) -> np.ndarray:
+        """The (9, n) state values of the ego at ``stamps`` (rows :data:`FLOAT_COLUMNS`); the
+        ego frame reaches the map frame."""
         try:
             xyz, quat = self.tf.lookup(self.options.ego_frame, self.options.map_frame, stamps)
         except MissingTransform as exc:
@@ -518,61 +554,37 @@ class FrameBuilder:
             "bag is read (a dataset ingested it without: query the bag as a file)"
         }
 
-    def _trace(self, parts: list[_Part]) -> LabelTrace:
-        """One trace of consecutive parts, the first of them emitted as frame ``self.emitted``:
-        objects numbered in order of first appearance, each with its class there; of the rows
-        of one object in one frame the first is kept."""
-        offsets = np.cumsum([0] + [len(p.stamps) for p in parts]).tolist()
-        starts = np.cumsum([0] + [len(p.frame) for p in parts]).tolist()
-        n = starts[-1]
-        first, category = np.full(len(self.ids), n, dtype=np.int64), np.zeros(len(self.ids), dtype=np.int64)
-        for p, start in zip(parts, starts):  # (parts in frame order: an object's first part is the earliest)
-            new = first[p.seen] == n
-            first[p.seen[new]], category[p.seen[new]] = p.first[new] + start, p.first_class[new]
-        seen = np.flatnonzero(first < n)
-        objects = seen[np.argsort(first[seen], kind="stable")]
-        number = np.zeros(len(self.ids), dtype=np.int32)
-        number[objects] = np.arange(len(objects), dtype=np.int32)
-        frame, obj, values = np.empty(n, dtype=np.int32), np.empty(n, dtype=np.int32), np.empty((9, n))
-        end = 0
-        for p, offset in zip(parts, offsets):  # (parts hold consecutive frames: each is ordered alone)
-            numbers, frames, part_values = number[p.ids], p.frame, p.values
-            key = frames.astype(np.int64) * max(len(objects), 1) + numbers
-            if not (key[1:] > key[:-1]).all():  # an object twice in a frame, or objects out of order
-                order = np.argsort(key, kind="stable")
-                keep = order[np.r_[True, key[order][1:] != key[order][:-1]]]
-                numbers, frames, part_values = numbers[keep], frames[keep], np.take(part_values, keep, axis=1)
-            rows = slice(end, end + len(numbers))
-            np.add(frames, offset, out=frame[rows])
-            obj[rows], values[:, rows] = numbers, part_values
-            end = rows.stop
-        frame, obj, values = frame[:end], obj[:end], values[:, :end]
-        x, y, z, heading, length, width, height, vx, vy = values
-        lane = np.full(len(frame), -1, dtype=np.int32)
+    def _trace(self, rows: _Rows) -> LabelTrace | None:
+        """The trace of ``rows`` (None when they hold no frame), its first frame emitted as
+        frame ``self.emitted``."""
+        if not rows.frames:
+            return None
+        n = rows.size
+        values = dict(zip(FLOAT_COLUMNS, (c.array(n) for c in rows.values)))
         states = StateTable.build(
-            frame, obj, x, y, heading, z=z, length=length, width=width, height=height, vx=vx, vy=vy, lane=lane
+            rows.frame.array(n), rows.object.array(n), lane=np.full(n, -1, dtype=np.int32), **values
         )
         names, class_names = self.ids.names, self.classes.names
         objects_table = ObjectTable.build(
-            [names[k] for k in objects.tolist()], [str(class_names[c]) for c in category[objects].tolist()]
+            [names[k] for k in rows.objects], [str(class_names[c]) for c in rows.category]
         )
         images = (
-            parts[0].images
-            if len(parts) == 1
-            else concatenate_layers([(p.images, o, np.empty(0, np.int32)) for p, o in zip(parts, offsets)])
+            rows.images[0][0]
+            if len(rows.images) == 1
+            else concatenate_layers([(layer, o, np.empty(0, np.int32)) for layer, o in rows.images])
         )
         trace = LabelTrace.build(
             self.name,
-            np.arange(self.emitted, self.emitted + offsets[-1]),
-            np.concatenate([p.times for p in parts]),
+            np.arange(self.emitted, self.emitted + rows.frames),
+            np.concatenate(rows.times),
             objects_table,
             states,
-            ego=EGO_ID if parts[0].has_ego else None,
+            ego=EGO_ID if rows.has_ego else None,
             images=images,
             attributes={"dataset": "ros2-bag", "time_origin_ns": self.origin, **self._ego_size_note()},
             source=self.source,
         )
-        self.emitted += offsets[-1]
+        self.emitted += rows.frames
         return trace
 
 

@@ -37,6 +37,29 @@ def test_validate_rejects_duplicates_and_bad_codes():
         ObjectTable.build(["a", "a"], ["car", "car"])
 
 
+def test_build_checks_the_row_order_once_and_still_refuses_bad_rows(monkeypatch):
+    objects = ObjectTable.build(["a", "b"], ["car", "car"])
+    calls = []
+    row_keys = StateTable.row_keys
+    monkeypatch.setattr(StateTable, "row_keys", lambda self, n: calls.append(n) or row_keys(self, n))
+    LabelTrace.build(
+        "t", [0, 1], [0.0, 0.1], objects, StateTable.build([0, 0, 1], [0, 1, 1], [0] * 3, [0] * 3, [0] * 3)
+    )
+    assert len(calls) == 1  # (found in order: not checked again)
+    LabelTrace.build(
+        "t", [0, 1], [0.0, 0.1], objects, StateTable.build([1, 0, 0], [1, 0, 1], [0] * 3, [0] * 3, [0] * 3)
+    )
+    assert len(calls) == 3  # (sorted, then checked)
+    with pytest.raises(ValueError, match="duplicates"):  # (duplicates found after the sort)
+        LabelTrace.build(
+            "t", [0, 1], [0.0, 0.1], objects, StateTable.build([1, 0, 1], [0, 0, 0], [0] * 3, [0] * 3, [0] * 3)
+        )
+    with pytest.raises(ValueError, match="object out of range"):  # (in order, but not objects of the trace)
+        LabelTrace.build("t", [0], [0.0], objects, StateTable.build([0, 0], [-1, 0], [0] * 2, [0] * 2, [0] * 2))
+    with pytest.raises(ValueError, match="object out of range"):
+        LabelTrace.build("t", [0], [0.0], objects, StateTable.build([0, 0], [0, 2], [0] * 2, [0] * 2, [0] * 2))
+
+
 def test_dense_and_present():
     t = small_trace()
     assert t.present().tolist() == [[True, True], [True, False], [True, False]]

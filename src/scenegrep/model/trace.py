@@ -97,7 +97,7 @@ class LabelTrace:
             states,
             **optional,
         )
-        trace.validate()
+        trace._validate(ordered=order is None)
         return trace
 
     # ------------------------------------------------------------------ sizes
@@ -122,6 +122,12 @@ class LabelTrace:
 
     def validate(self) -> None:
         """Raise ValueError unless the tables are consistent (sorted, codes in range, aligned)."""
+        self._validate(ordered=False)
+
+    def _validate(self, ordered: bool) -> None:
+        """:meth:`validate`; ``ordered``: the states were found in strictly increasing (frame,
+        object) order (:meth:`StateTable.sort_order` gave None: with the codes in range, that is
+        the order checked here, so it is not checked again)."""
         s = self.states
         if len(self.frame_time) != self.n_frames:
             raise ValueError("frame_index and frame_time differ in length")
@@ -131,8 +137,8 @@ class LabelTrace:
             raise ValueError("state object out of range")
         if len(s) and (s.lane.min() < -1 or s.lane.max() >= len(self.lane_ids)):
             raise ValueError("state lane code out of range")
-        key = s.row_keys(max(self.n_objects, 1))
-        if np.any(key[1:] <= key[:-1]):
+        key = None if ordered else s.row_keys(max(self.n_objects, 1))
+        if key is not None and np.any(key[1:] <= key[:-1]):
             raise ValueError("states must be sorted by (frame, object) without duplicates")
         if self.behaviours is not None and len(self.behaviours) != len(s):
             raise ValueError("behaviour labels must align with state rows")

@@ -99,7 +99,11 @@ class _Names:
     def codes(self, column: np.ndarray | Coded) -> tuple[np.ndarray, np.ndarray]:
         """The code of every row of a string column (int32), and the codes of its names."""
         coded = column if isinstance(column, Coded) else Coded.of(column)
-        table = np.fromiter(map(self.code, coded.names.tolist()), dtype=np.int32, count=len(coded.names))
+        names = coded.names.tolist()
+        try:  # (every name known: looked up with no Python call per name)
+            table = np.fromiter(map(self.index.__getitem__, names), dtype=np.int32, count=len(names))
+        except KeyError:
+            table = np.fromiter(map(self.code, names), dtype=np.int32, count=len(names))
         return table[coded.codes], table
 
 

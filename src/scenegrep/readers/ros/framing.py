@@ -428,11 +428,10 @@ class FrameBuilder:
             ids.append(np.full(len(stamps), self.ids.code(EGO_ID), dtype=np.int32))
             classes.append(np.full(len(stamps), self.classes.code(EGO_ID), dtype=np.int32))
             objects.append(ids[-1][:1])
-        frame_all, ids_all, classes_all = (
-            np.concatenate(c) if c else np.empty(0, np.int32) for c in (frame, ids, classes)
-        )
-        dest, kept = self._placement(frame_all, ids_all, classes_all, objects, out)
-        start, columns = out.size, [c.rows(out.size, out.size + len(kept)) for c in out.values]
+        frame_all, ids_all = (np.concatenate(c) if c else np.empty(0, np.int32) for c in (frame, ids))
+        dest, kept_frames, kept_numbers = self._placement(frame_all, ids_all, classes, objects, out)
+        start, stop = out.size, out.size + len(kept_frames)
+        columns = [c.rows(start, stop) for c in out.values]
         offset = 0
         for (seg, rows), rows_frame in zip(taken, frame):  # (the boxes first: their errors come first)
             self._values(seg, rows, dest[offset : offset + len(rows_frame)], columns)
@@ -441,9 +440,9 @@ class FrameBuilder:
             ego, at = self._ego(stamps), dest[offset:]
             for column, values in zip(columns, ego):
                 column[at[at >= 0]] = values[at >= 0]
-        out.frame.rows(start, start + len(kept))[:] = frame_all[kept] + out.frames
-        out.object.rows(start, start + len(kept))[:] = out.number[ids_all[kept]]
-        out.size += len(kept)
+        np.add(kept_frames, out.frames, out=out.frame.rows(start, stop))
+        out.object.rows(start, stop)[:] = kept_numbers
+        out.size = stop
         out.images.append((images, out.frames))
         out.stamps.append(stamps)
         out.times.append((stamps - self.origin) / 1e9)
@@ -451,32 +450,41 @@ class FrameBuilder:
         out.has_ego = has_ego if out.has_ego is None else out.has_ego
 
     def _placement(
-        self, frame: np.ndarray, ids: np.ndarray, classes: np.ndarray, objects: list[np.ndarray], out: _Rows
-    ) -> tuple[np.ndarray, np.ndarray]:
+        self, frame: np.ndarray, ids: np.ndarray, classes: list[np.ndarray], objects: list[np.ndarray], out: _Rows
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """For rows of frames (positions among the new frames), object ids and classes (builder
-        codes), in pick order: the row of ``out``'s columns each is written to, relative to the
-        rows it holds (-1: a repeat of its object in its frame, dropped), and the rows kept in
-        the order they are written. The objects first seen here are numbered in ``out`` (in
-        order of first appearance: by frame, then pick order)."""
+        codes; ``classes`` in parts to concatenate), in pick order: the row of ``out``'s columns
+        each is written to, relative to the rows it holds (-1: a repeat of its object in its
+        frame, dropped), and the frame and object number of each row written, in order. The
+        objects first seen here are numbered in ``out`` (in order of first appearance: by frame,
+        then pick order)."""
         by_frame = None if (frame[1:] >= frame[:-1]).all() else np.argsort(frame, kind="stable")
-        in_frames = ids if by_frame is None else ids[by_frame]
         number = out.numbers(len(self.ids))
-        candidates = np.unique(np.concatenate(objects)) if objects else in_frames
-        seen, first = self._first_rows(in_frames, candidates[number[candidates] < 0])
-        if len(seen):
+        candidates = np.unique(np.concatenate(objects)) if objects else ids
+        new = candidates[number[candidates] < 0]
+        if len(new):
+            seen, first = self._first_rows(ids if by_frame is None else ids[by_frame], new)
             order = np.argsort(first, kind="stable")
             number[seen[order]] = np.arange(len(out.objects), len(out.objects) + len(seen), dtype=np.int32)
             out.objects += seen[order].tolist()
-            first_class = classes[first[order]] if by_frame is None else classes[by_frame[first[order]]]
-            out.category += first_class.tolist()
-        kept = np.arange(len(frame)) if by_frame is None else by_frame
-        key = frame[kept].astype(np.int64) * max(len(out.objects), 1) + number[ids[kept]]
+            first = first[order] if by_frame is None else by_frame[first[order]]
+            out.category += np.concatenate(classes)[first].tolist()
+        kept_frames = frame if by_frame is None else frame[by_frame]
+        kept_numbers = number[ids if by_frame is None else ids[by_frame]]
+        key = kept_frames.astype(np.int64)
+        key *= max(len(out.objects), 1)
+        key += kept_numbers
+        kept = by_frame
         if not (key[1:] > key[:-1]).all():  # an object twice in a frame, or objects out of order
             order = np.argsort(key, kind="stable")
-            kept = kept[order[np.r_[True, key[order][1:] != key[order][:-1]]]]
+            order = order[np.r_[True, key[order][1:] != key[order][:-1]]]
+            kept = order if kept is None else kept[order]
+            kept_frames, kept_numbers = kept_frames[order], kept_numbers[order]
+        if kept is None:
+            return np.arange(len(frame), dtype=np.int64), kept_frames, kept_numbers
         dest = np.full(len(frame), -1, dtype=np.int64)
         dest[kept] = np.arange(len(kept))
-        return dest, kept
+        return dest, kept_frames, kept_numbers
 
     def _first_rows(self, ids: np.ndarray, candidates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The codes among ``candidates`` that ``ids`` holds, and the first row of each (no sort:

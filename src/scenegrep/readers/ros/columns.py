@@ -25,11 +25,11 @@ _FLAGS = getattr(mmap, "MAP_PRIVATE", 0) | getattr(mmap, "MAP_ANONYMOUS", 0)
 
 
 def _anonymous(size: int) -> mmap.mmap:
-    """Zeroed private memory of ``size`` bytes, advised into huge pages where the system has them."""
-    memory = mmap.mmap(-1, size, flags=_FLAGS) if _FLAGS else mmap.mmap(-1, size)
-    if hasattr(mmap, "MADV_HUGEPAGE"):
-        memory.madvise(mmap.MADV_HUGEPAGE)
-    return memory
+    """Zeroed private memory of ``size`` bytes, with the system's default pages (advising huge
+    pages, as numpy does for large arrays, made first touches slower where the kernel compacts
+    memory to find them: 100k-message bag, framing 6.0-6.2 us per message with 4 kB pages
+    against 8.3-15.3 with huge pages)."""
+    return mmap.mmap(-1, size, flags=_FLAGS) if _FLAGS else mmap.mmap(-1, size)
 
 
 class Column:

@@ -27,13 +27,19 @@ nearest point may lie on it: not where the point lies :data:`FOOT_SLACK_M` or mo
 segment's start along it and along the segment before it (whose end is then nearer), nor that far
 past its end along it and along the next segment. Each candidate segment's D interval is
 narrowed to the hull of the D left (Town01's centreline segments are 0.2-0.5 m long and a reach
-some metres, so most candidates fall away here rather than in the cutting below).
+some metres, so most candidates fall away here rather than in the cutting below). A candidate
+whose swept segment over that hull then misses the *holding region* of its lane or shoulder
+(:func:`_holders`: every point whose direction Scenic's rules read off that centreline; in an
+intersection area, where the lanes overlap, only the part no lane listed before it covers) is
+dropped too: most of the reach's candidates near an intersection, and beside a lane of the
+other direction, are of that kind, and each costs the cutting below far more than this test.
 
 Why the preimage holds every walk ending at E (the invariant a refutation rests on): take a walk
 from X for D with headings h_0 .. h_{n-1} and points p_0 = X .. p_n = E. Going back from p_{k+1},
 the segment that gives p_k its heading lies within its reach of p_k, and p_k within |D| / n of
 p_{k+1}, so h_k is among the candidates, and p_k = E + D b_k lies on the branch's swept segment
-for that D. The field at p_k is h_k, and the D sub-interval holding D is one on which the field
+for that D, and in the holding region of that segment's centreline (so that swept segment meets
+it). The field at p_k is h_k, and the D sub-interval holding D is one on which the field
 does not change: it changes only (i) across an area boundary (a lane, intersection or shoulder,
 and the 5 cm bands around them), which decides the rule that applies, or (ii) within one lane,
 where its nearest centreline segment changes: at a vertex line between adjacent segments that
@@ -53,7 +59,9 @@ box but not at E is not in it.
 
 With ``check_first=False`` the first heading h_0 is not checked against the field along X's
 segment: the caller checks it at the start it picks (a start on a curb lies on the linework, where
-the heading read inside a sub-interval need not be the one at the start itself).
+the heading read inside a sub-interval need not be the one at the start itself); nor is it
+tried against the holding regions (the caller walks every start again, and those rows stay the
+reach's).
 """
 
 from __future__ import annotations
@@ -84,6 +92,16 @@ NEIGHBOUR_M = 0.01
 interval (too short to be surely nearer by more than rounding)."""
 
 
+HOLD_BAND_M = 0.06
+"""The band around a lane (and its intersection areas) or a shoulder in which a point in no lane may
+take its direction (metres): Scenic's tolerance (:data:`~.geometry.ELEMENT_REACH_M`, 0.05) and
+room for the buffer's chords (1.2 mm at 0.06 m)."""
+
+HOLD_SLACK_M = 1e-6
+"""How near a swept segment must come to a lane's holding region to keep its headings (metres:
+slack for rounding)."""
+
+
 DOMAIN_SLACK_M = 1e-6
 """Slack on the reach of a branch's remaining steps towards the start's domain (metres)."""
 
@@ -91,19 +109,27 @@ DOMAIN_SLACK_M = 1e-6
 @dataclass
 class Inverse:
     """Per map: every centreline segment (lanes, then shoulders): an R-tree of the boxes within
-    its reach, its heading (radians), its ends (rows of x0, y0, x1, y1), its reach (metres:
-    no point farther from it takes its heading), its unit direction and those of the segments
-    before and after it on its centreline (rows of x, y; NaN: none, or shorter than
-    :data:`NEIGHBOUR_M`); and the union of the lanes, intersection areas and shoulders (off which
-    a point may take heading 0)."""
+    its reach, its heading (radians) with the step direction ``u(h) = (-sin h, cos h)``'s
+    negation (``step``: rows of sin h, -cos h, what a step back along it adds per metre of D),
+    its ends (rows of x0, y0, x1, y1), its reach (metres: no point farther from it takes its
+    heading), the box within its reach (``near``: rows of x_lo, y_lo, x_hi, y_hi), its unit
+    direction and those of the segments before and after it on its centreline (rows of x, y; NaN:
+    none, or shorter than :data:`NEIGHBOUR_M`), and its centreline (``owner``: an index into
+    ``holds``, a region per lane, then per shoulder, holding every point whose direction Scenic
+    reads off that centreline: :func:`_holders`); and the union of the lanes, intersection areas
+    and shoulders (off which a point may take heading 0)."""
 
     tree: shapely.STRtree
     heading: np.ndarray
+    step: np.ndarray
     ends: np.ndarray
     reach: np.ndarray
+    near: np.ndarray
     unit: np.ndarray
     before: np.ndarray
     after: np.ndarray
+    owner: np.ndarray
+    holds: np.ndarray
     roads: shapely.Geometry
 
 
@@ -161,13 +187,15 @@ def _build_inverse(geometry: MapGeometry) -> Inverse:
         gap = float(np.max(shapely.distance(shapely.points(coords), lanes), initial=0.0)) + 0.25
         inside = np.isin(owner, [index[lane] for lane in area.lanes if lane in index])
         reach[inside] = np.maximum(reach[inside], lane_reach[inside] + gap)
-    centres, reaches = [lines], [reach]
-    if road_map.shoulders and all(a.centreline is not None for a in road_map.shoulders):
+    centres, reaches, owners = [lines], [reach], [owner]
+    with_shoulders = bool(road_map.shoulders) and all(a.centreline is not None for a in road_map.shoulders)
+    if with_shoulders:
         shoulders = Polylines([a.centreline for a in road_map.shoulders])
         areas = np.array([a.polygon for a in road_map.shoulders], dtype=object)
         owner = np.repeat(np.arange(len(shoulders)), shoulders.count)
         centres.append(shoulders)
         reaches.append(_reach(areas, shoulders)[owner] + ELEMENT_REACH_M)
+        owners.append(len(lines) + owner)
     start = np.concatenate([c.start for c in centres])
     end = np.concatenate([c.end for c in centres])
     heading = np.concatenate([c.heading for c in centres])
@@ -179,7 +207,55 @@ def _build_inverse(geometry: MapGeometry) -> Inverse:
     roads = shapely.union_all(areas)
     shapely.prepare(roads)
     ends = np.concatenate([start, end], axis=1)
-    return Inverse(shapely.STRtree(near), heading, ends, reach, unit, before, after, roads)
+    step = np.stack([np.sin(heading), -np.cos(heading)], axis=1)
+    boxes = np.concatenate([low, high], axis=1)
+    holds = _holders(road_map, with_shoulders)
+    owner = np.concatenate(owners)
+    return Inverse(shapely.STRtree(near), heading, step, ends, reach, boxes, unit, before, after, owner, holds, roads)
+
+
+def _holders(road_map, with_shoulders: bool) -> np.ndarray:
+    """Per lane (then per shoulder, ``with_shoulders``): a region (prepared) holding every point
+    whose road direction :meth:`~.geometry.MapGeometry.scenic_headings` reads off its centreline.
+    A point of an intersection area with lanes takes the first of its lanes (in the area's order)
+    holding it, else the nearest of them; a point in no such area the first lane holding it; a
+    point in no lane and no such area a shoulder holding it, else the nearest lane of an area
+    within Scenic's tolerance, else the nearest lane or the first shoulder within it. So a lane
+    holds: in each area listing it, its part that no lane listed before it covers, and the
+    area's part outside its lanes; itself outside those areas (inside areas without lanes too);
+    and, outside every lane, the band of :data:`HOLD_BAND_M` around itself and its areas (around
+    a shoulder, for a shoulder)."""
+    polygons = road_map.lane_polygons
+    index = road_map.lane_index
+    areas = road_map.intersections
+    listed = [[index[lane] for lane in a.lanes if lane in index] for a in areas]
+    bare = shapely.union_all([a.polygon for a, lanes in zip(areas, listed) if not lanes])
+    gaps = [shapely.difference(a.polygon, shapely.union_all(polygons[lanes])) for a, lanes in zip(areas, listed)]
+    tree = road_map._lane_tree
+    holds = []
+    for k in range(len(polygons)):
+        parts, own = [], []
+        for a, lanes, gap in zip(areas, listed, gaps):
+            if k not in lanes:
+                continue
+            first = shapely.intersection(polygons[k], a.polygon)
+            parts += [shapely.difference(first, shapely.union_all(polygons[lanes[: lanes.index(k)]])), gap]
+            own.append(a.polygon)
+        parts.append(shapely.difference(polygons[k], shapely.difference(shapely.union_all(own), bare)))
+        parts.append(
+            _outside_lanes(shapely.buffer(shapely.union_all([polygons[k], *own]), HOLD_BAND_M), tree, polygons)
+        )
+        holds.append(shapely.union_all(parts))
+    if with_shoulders:
+        holds += [_outside_lanes(shapely.buffer(a.polygon, HOLD_BAND_M), tree, polygons) for a in road_map.shoulders]
+    found = np.array(holds, dtype=object)
+    shapely.prepare(found)
+    return found
+
+
+def _outside_lanes(zone: shapely.Geometry, tree: shapely.STRtree, polygons: np.ndarray) -> shapely.Geometry:
+    """The part of ``zone`` in no lane."""
+    return shapely.difference(zone, shapely.union_all(polygons[tree.query(zone)]))
 
 
 def _neighbours(lines: Polylines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -226,7 +302,7 @@ def preimages(
     done = []
     while len(b.row):
         last = b.left == 1
-        moved = _candidates(inv, ex, ey, b)
+        moved = _candidates(inv, ex, ey, b, ~last | check_first)
         if domain is not None:
             moved = moved.take(np.flatnonzero(_may_start(ex, ey, moved.branches, domain)))
         if check_first:
@@ -237,7 +313,7 @@ def preimages(
             keep = moved.take(np.flatnonzero(~last[moved.parent]))
             first = moved.take(np.flatnonzero(last[moved.parent]))
             done.append(first.branches)
-            moved = _consistent(geometry, field, lw, ex, ey, keep)
+            moved = _consistent(geometry, field, lw, ex, ey, keep) if len(keep.parent) else keep
         finished = moved.left == 0
         done.append(moved.branches.take(np.flatnonzero(finished)))
         b = moved.branches.take(np.flatnonzero(~finished))
@@ -298,71 +374,81 @@ def _clipped(ex, ey, moved: _Moved, domain: np.ndarray) -> _Moved:
     return moved.take(np.flatnonzero(keep))
 
 
-def _candidates(inv: Inverse, ex, ey, b: _Back) -> _Moved:
+def _candidates(inv: Inverse, ex, ey, b: _Back, held: np.ndarray) -> _Moved:
     """Each branch one step back along every heading a centreline segment near it has, its D
     interval narrowed to where the new point stays within the segment's reach (the hull over the
-    segments sharing a heading), and along heading 0 where the new point may leave the road."""
-    px, qx = ex[b.row] + b.lo * b.ax, ex[b.row] + b.hi * b.ax
-    py, qy = ey[b.row] + b.lo * b.ay, ey[b.row] + b.hi * b.ay
+    segments sharing a heading), and along heading 0 where the new point may leave the road. For
+    the branches marked ``held``, a segment's heading is tried only where the new point may lie in
+    its centreline's holding region (:func:`_holders`)."""
+    x, y = ex[b.row], ey[b.row]
+    px, qx = x + b.lo * b.ax, x + b.hi * b.ax
+    py, qy = y + b.lo * b.ay, y + b.hi * b.ay
     grow = np.maximum(np.abs(b.lo), np.abs(b.hi)) / b.steps
     boxes = shapely.box(
         np.minimum(px, qx) - grow, np.minimum(py, qy) - grow, np.maximum(px, qx) + grow, np.maximum(py, qy) + grow
     )
-    branch, segment = inv.tree.query(boxes)
-    branch = np.concatenate([branch, np.arange(len(b.row))])
+    near, segment = inv.tree.query(boxes)
+    steps = b.steps[near]
+    ax = np.concatenate([b.ax[near] + inv.step[segment, 0] / steps, b.ax + 0.0])
+    ay = np.concatenate([b.ay[near] + inv.step[segment, 1] / steps, b.ay + -1.0 / b.steps])
+    branch = np.concatenate([near, np.arange(len(b.row))])
     heading = np.concatenate([inv.heading[segment], np.zeros(len(b.row))])
-    lo, hi = _within(ex, ey, b, branch, heading, inv, segment)
-    keep = lo <= hi
-    branch, heading, lo, hi = branch[keep], heading[keep], lo[keep], hi[keep]
-    order = np.lexsort((heading, branch))
-    branch, heading, lo, hi = branch[order], heading[order], lo[order], hi[order]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lo, hi = _within(inv, x[branch], y[branch], b.lo[branch], b.hi[branch], ax, ay, segment, held[near])
+    keep = np.flatnonzero(lo <= hi)
+    order = keep[np.lexsort((heading[keep], branch[keep]))]
+    branch, heading = branch[order], heading[order]
     new = np.ones(len(branch), dtype=bool)
     new[1:] = (branch[1:] != branch[:-1]) | (heading[1:] != heading[:-1])
     starts = np.flatnonzero(new)
     moved = b.take(branch[starts])
-    moved.lo, moved.hi = np.minimum.reduceat(lo, starts), np.maximum.reduceat(hi, starts)
-    heading = heading[starts]
-    moved.ax = moved.ax + np.sin(heading) / moved.steps
-    moved.ay = moved.ay - np.cos(heading) / moved.steps
+    moved.lo, moved.hi = np.minimum.reduceat(lo[order], starts), np.maximum.reduceat(hi[order], starts)
+    moved.ax, moved.ay = ax[order[starts]], ay[order[starts]]
     moved.left = moved.left - 1
+    heading = heading[starts]
     moved.first = np.where(moved.left == 0, heading, np.nan)
     return _Moved(moved, heading, branch[starts])
 
 
-def _within(ex, ey, b: _Back, branch, heading, inv: Inverse, segment) -> tuple[np.ndarray, np.ndarray]:
-    """The D interval (lo > hi: none) on which branch ``branch[i]``'s point one step back along
-    ``heading[i]`` comes within its reach of the segment ``segment[i]`` of ``inv`` where its
+def _within(inv: Inverse, x, y, lo, hi, ax, ay, segment, held) -> tuple[np.ndarray, np.ndarray]:
+    """The D interval (lo > hi: none) on which the point ``(x, y) + D (ax, ay)`` (row i, D in
+    [lo[i], hi[i]]) comes within its reach of the segment ``segment[i]`` of ``inv`` where its
     centreline's nearest point may lie on that segment (:func:`_nearest_on`), as the hull of that
-    set; for the rows past ``segment`` (heading 0), where it may leave the roads. One pass over
-    both kinds of rows (the per-step numpy and shapely calls are the dearer part here)."""
-    ax = b.ax[branch] + np.sin(heading) / b.steps[branch]
-    ay = b.ay[branch] + -np.cos(heading) / b.steps[branch]
-    lo, hi = b.lo[branch], b.hi[branch]
-    x, y = ex[b.row[branch]], ey[b.row[branch]]
-    p = np.stack([x + lo * ax, y + lo * ay], axis=1)
-    q = np.stack([x + hi * ax, y + hi * ay], axis=1)
+    set, dropped where ``held[i]`` and that part of the swept segment misses the centreline's
+    holding region; for the rows past ``segment`` (heading 0), where it may leave the roads. Rows whose
+    swept segment misses the box within the segment's reach are dropped before the exact test
+    (most of them: the R-tree's query box is a whole step wide in every direction). Call with
+    numpy's divide and invalid warnings off."""
+    px, qx = x + lo * ax, x + hi * ax
+    py, qy = y + lo * ay, y + hi * ay
     n = len(segment)
-    start, end = np.full(len(p), np.inf), np.full(len(p), -np.inf)
-    off = n + np.flatnonzero(~shapely.covered_by(shapely.linestrings(np.stack([p[n:], q[n:]], axis=1)), inv.roads))
+    start, end = np.full(len(px), np.inf), np.full(len(px), -np.inf)
+    zero = shapely.linestrings(np.stack([px[n:], py[n:], qx[n:], qy[n:]], axis=1).reshape(-1, 2, 2))
+    off = n + np.flatnonzero(~shapely.covered_by(zero, inv.roads))
     start[off], end[off] = lo[off], hi[off]
-    ends, reach = inv.ends[segment], inv.reach[segment]
-    low = np.minimum(ends[:, :2], ends[:, 2:]) - reach[:, None]
-    high = np.maximum(ends[:, :2], ends[:, 2:]) + reach[:, None]
-    p, q = p[:n], q[:n]
-    meet = np.flatnonzero(np.all((np.minimum(p, q) <= high) & (np.maximum(p, q) >= low), axis=1))
-    t_lo, t_hi = np.full(n, np.inf), np.full(n, -np.inf)
-    a, z, r, s = ends[meet, :2], ends[meet, 2:], (q - p)[meet], segment[meet]
-    t_lo[meet], t_hi[meet] = _nearest_on(
-        p[meet],
-        r,
-        (a, z),
-        inv.unit[s],
-        (inv.before[s], inv.after[s]),
-        _stadium(p[meet], r, a, z, reach[meet]),
+    box = inv.near[segment]
+    meet = np.flatnonzero(
+        (np.minimum(px[:n], qx[:n]) <= box[:, 2])
+        & (np.maximum(px[:n], qx[:n]) >= box[:, 0])
+        & (np.minimum(py[:n], qy[:n]) <= box[:, 3])
+        & (np.maximum(py[:n], qy[:n]) >= box[:, 1])
     )
-    hit = np.flatnonzero(t_lo <= t_hi)  # elsewhere t_hi may be -inf, and -inf * 0 (a point interval) is NaN
-    start[hit] = lo[hit] + t_lo[hit] * (hi[hit] - lo[hit])
-    end[hit] = lo[hit] + t_hi[hit] * (hi[hit] - lo[hit])
+    p = np.stack([px[meet], py[meet]], axis=1)
+    r = np.stack([qx[meet], qy[meet]], axis=1) - p
+    s = segment[meet]
+    a, z = inv.ends[s, :2], inv.ends[s, 2:]
+    t_lo, t_hi = _nearest_on(
+        p, r, (a, z), inv.unit[s], (inv.before[s], inv.after[s]), _stadium(p, r, a, z, inv.reach[s])
+    )
+    hit = meet[t_lo <= t_hi]  # elsewhere t_hi may be -inf, and -inf * 0 (a point interval) is NaN
+    t_lo, t_hi = t_lo[t_lo <= t_hi], t_hi[t_lo <= t_hi]
+    width = hi[hit] - lo[hit]
+    start[hit], end[hit] = lo[hit] + t_lo * width, lo[hit] + t_hi * width
+    test = hit[held[hit]]
+    swept = np.stack([x[test] + start[test] * ax[test], y[test] + start[test] * ay[test]], axis=1)
+    swept = np.stack([swept, np.stack([x[test] + end[test] * ax[test], y[test] + end[test] * ay[test]], axis=1)], 1)
+    away = test[~shapely.dwithin(shapely.linestrings(swept), inv.holds[inv.owner[segment[test]]], HOLD_SLACK_M)]
+    start[away], end[away] = np.inf, -np.inf
     return start, end
 
 
@@ -372,78 +458,71 @@ def _nearest_on(p, r, ends, unit, neighbours, span) -> tuple[np.ndarray, np.ndar
     ``unit``: its direction): dropped are the t at which the point lies :data:`FOOT_SLACK_M` or
     more before the start along it and along the segment before (``neighbours[0]``: its direction;
     NaN: none), whose end is then nearer, and likewise past the end along it and the segment after
-    (``neighbours[1]``)."""
+    (``neighbours[1]``). Call with numpy's divide and invalid warnings off."""
     low, high = span
-    forbidden = []
-    for vertex, sign, neighbour in ((ends[0], -1.0, neighbours[0]), (ends[1], 1.0, neighbours[1])):
-        f_lo, f_hi = np.zeros(len(p)), np.ones(len(p))
-        for direction in (unit, neighbour):
-            along = sign * np.einsum("ij,ij->i", p - vertex, direction)
-            rate = sign * np.einsum("ij,ij->i", r, direction)
-            f_lo, f_hi = _linear_within(f_lo, f_hi, along, rate, FOOT_SLACK_M, np.inf)
-        none = np.isnan(f_lo) | np.isnan(f_hi) | np.isnan(neighbour[:, 0])
-        forbidden.append((np.where(none, np.inf, f_lo), np.where(none, -np.inf, f_hi)))
+    vertex = np.stack([ends[0], ends[0], ends[1], ends[1]])
+    direction = np.stack([unit, neighbours[0], unit, neighbours[1]])
+    sign = np.array([[-1.0], [-1.0], [1.0], [1.0]])
+    along = sign * np.einsum("kij,kij->ki", p - vertex, direction)
+    rate = sign * np.einsum("ij,kij->ki", r, direction)
+    f_lo, f_hi = _linear_bounds(along, rate, FOOT_SLACK_M, np.inf)
+    f_lo = np.maximum(np.maximum(0.0, f_lo[0::2]), f_lo[1::2])
+    f_hi = np.minimum(np.minimum(1.0, f_hi[0::2]), f_hi[1::2])
+    none = np.isnan(f_lo) | np.isnan(f_hi) | np.isnan(direction[1::2, :, 0])
+    f_lo, f_hi = np.where(none, np.inf, f_lo), np.where(none, -np.inf, f_hi)
     for _ in range(2):
-        for f_lo, f_hi in forbidden:
-            low = np.where((low >= f_lo) & (low <= f_hi), f_hi, low)
-            high = np.where((high >= f_lo) & (high <= f_hi), f_lo, high)
+        for k in range(2):
+            low = np.where((low >= f_lo[k]) & (low <= f_hi[k]), f_hi[k], low)
+            high = np.where((high >= f_lo[k]) & (high <= f_hi[k]), f_lo[k], high)
     return low, high
 
 
 def _stadium(p, r, a, b, radius) -> tuple[np.ndarray, np.ndarray]:
     """The hull [t_lo, t_hi] (t_lo > t_hi: empty) of the t in [0, 1] at which p + t r lies within
-    ``radius`` of the segment a-b: the union of the band along it and the discs at its ends."""
+    ``radius`` of the segment a-b: the union of the band along it and the discs at its ends. Call
+    with numpy's divide and invalid warnings off."""
     w = b - a
     ww = np.einsum("ij,ij->i", w, w)
-    lows, highs = [], []
-    for centre in (a, b):
-        low, high = _quadratic_below(r, p - centre, radius)
-        lows.append(low)
-        highs.append(high)
     length = np.sqrt(ww)
     pa = p - a
-    low, high = np.zeros(len(p)), np.ones(len(p))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for f0, f1, bottom, top in (
-            (np.einsum("ij,ij->i", pa, w) / ww, np.einsum("ij,ij->i", r, w) / ww, 0.0, 1.0),
-            (_cross(w, pa) / length, _cross(w, r) / length, -radius, radius),
-        ):
-            low, high = _linear_within(low, high, f0, f1, bottom, top)
+    f0 = np.stack([np.einsum("ij,ij->i", pa, w) / ww, _cross(w, pa) / length])
+    f1 = np.stack([np.einsum("ij,ij->i", r, w) / ww, _cross(w, r) / length])
+    zero = np.zeros(len(p))
+    low, high = _linear_bounds(f0, f1, np.stack([zero, -radius]), np.stack([zero + 1.0, radius]))
     band = ww > 0
-    lows.append(np.where(band, low, np.inf))
-    highs.append(np.where(band, high, -np.inf))
-    lows_, highs_ = np.stack(lows), np.stack(highs)
-    empty = lows_ > highs_
-    t_lo = np.where(empty, np.inf, lows_).min(axis=0)
-    t_hi = np.where(empty, -np.inf, highs_).max(axis=0)
-    return t_lo, t_hi
+    low = np.where(band, np.maximum(np.maximum(0.0, low[0]), low[1]), np.inf)
+    high = np.where(band, np.minimum(np.minimum(1.0, high[0]), high[1]), -np.inf)
+    disc_lo, disc_hi = _quadratic_below(r, np.stack([pa, p - b]), radius)
+    lows, highs = np.concatenate([disc_lo, low[None]]), np.concatenate([disc_hi, high[None]])
+    empty = lows > highs
+    return np.where(empty, np.inf, lows).min(axis=0), np.where(empty, -np.inf, highs).max(axis=0)
 
 
 def _quadratic_below(r, d, radius) -> tuple[np.ndarray, np.ndarray]:
-    """The t in [0, 1] with |d + t r| <= radius, as an interval (low > high: none; an empty one
-    may be infinite)."""
+    """The t in [0, 1] with |d[k] + t r| <= radius (``d``: a stack of row sets, each like ``r``),
+    as intervals (low > high: none; an empty one may be infinite). Call with numpy's divide and
+    invalid warnings off."""
     rr = np.einsum("ij,ij->i", r, r)
-    dr = np.einsum("ij,ij->i", d, r)
-    c = np.einsum("ij,ij->i", d, d) - radius * radius
+    dr = np.einsum("kij,ij->ki", d, r)
+    c = np.einsum("kij,kij->ki", d, d) - radius * radius
     moving = rr > DEGENERATE_M**2
     disc = dr * dr - rr * c
-    with np.errstate(divide="ignore", invalid="ignore"):
-        root = np.sqrt(np.where(disc >= 0, disc, np.nan))
-        low = np.where(moving, (-dr - root) / rr, np.where(c <= 0, 0.0, np.inf))
-        high = np.where(moving, (-dr + root) / rr, np.where(c <= 0, 1.0, -np.inf))
+    root = np.sqrt(np.where(disc >= 0, disc, np.nan))
+    low = np.where(moving, (-dr - root) / rr, np.where(c <= 0, 0.0, np.inf))
+    high = np.where(moving, (-dr + root) / rr, np.where(c <= 0, 1.0, -np.inf))
     none = np.isnan(low) | np.isnan(high)
     return np.where(none, np.inf, np.maximum(low, 0.0)), np.where(none, -np.inf, np.minimum(high, 1.0))
 
 
-def _linear_within(low, high, f0, f1, bottom, top) -> tuple[np.ndarray, np.ndarray]:
-    """Narrow [low, high] to the t where bottom <= f0 + f1 t <= top."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u, v = (bottom - f0) / f1, (top - f0) / f1
+def _linear_bounds(f0, f1, bottom, top) -> tuple[np.ndarray, np.ndarray]:
+    """The t where bottom <= f0 + f1 t <= top, as intervals (low > high: none; -inf, inf: every
+    t), to be intersected with the others by maximum and minimum (NaN where f0 or f1 is)."""
+    u, v = (bottom - f0) / f1, (top - f0) / f1
     flat = np.abs(f1) <= 1e-300
     inside = (f0 >= bottom) & (f0 <= top)
-    new_low = np.where(flat, np.where(inside, low, np.inf), np.maximum(low, np.minimum(u, v)))
-    new_high = np.where(flat, np.where(inside, high, -np.inf), np.minimum(high, np.maximum(u, v)))
-    return new_low, new_high
+    low = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(u, v))
+    high = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(u, v))
+    return low, high
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -54,6 +54,7 @@ SCENE_LAYERS: tuple[tuple[str, ...], ...] = (
         "follow_regions",
         "follow_inverse",
         "heading_index",
+        "clip",
     ),  # map geometry
     ("context", "expressions", "specifiers", "lenient_boxes", "resolve", "needs"),  # syntax, specifier semantics
     ("dependencies", "randoms", "evaluate"),  # analysis and evaluation

@@ -11,7 +11,8 @@ fields over terms), :mod:`.values` and :mod:`.vectors` (what resolution computes
 vectors), :mod:`.domain` (Scenic's classes and defaults), :mod:`.program` (the resolved program:
 objects' feature terms, requirements). *Map geometry*: :mod:`.geometry` (regions and fields on a
 road map, vectorised), :mod:`.shapes` (exact box and sector tests), :mod:`.unknown` (unknown map
-layers), :mod:`.follow` and its walks ``follow_pieces``, ``follow_regions``, ``follow_inverse``.
+layers), :mod:`.follow` and its walks ``follow_pieces``, ``follow_regions``, ``follow_inverse``,
+:mod:`.clip` (lines cut by a start's domain, part by part).
 *Syntax and specifier semantics*: :mod:`.expressions` (IR expressions -> values),
 :mod:`.specifiers` (``new Class spec, ...``), :mod:`.lenient_boxes` (implicit requirements eased by
 the tolerance), :mod:`.resolve` (statements; the :class:`~.resolve.Resolver`, the

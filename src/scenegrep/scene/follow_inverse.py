@@ -73,6 +73,7 @@ import numpy as np
 import shapely
 
 from ..model.polylines import Polylines
+from .clip import clipped
 from .follow_pieces import DEGENERATE_M, _by_step_count, _Columns, _split, linework
 from .geometry import ELEMENT_REACH_M, MapGeometry
 from .regions import Field
@@ -359,7 +360,7 @@ def _clipped(ex, ey, moved: _Moved, domain: np.ndarray) -> _Moved:
     q = np.stack([ex[b.row[last]] + b.hi[last] * b.ax[last], ey[b.row[last]] + b.hi[last] * b.ay[last]], axis=1)
     r = q - p
     rr = np.einsum("ij,ij->i", r, r)
-    inside = shapely.intersection(shapely.linestrings(np.stack([p, q], axis=1)), domain[b.row[last]])
+    inside = clipped(shapely.linestrings(np.stack([p, q], axis=1)), domain[b.row[last]])
     coords, owner = shapely.get_coordinates(inside, return_index=True)
     t = np.einsum("ij,ij->i", coords - p[owner], r[owner]) / np.maximum(rr[owner], 1e-300)
     t_lo, t_hi = np.full(len(last), np.inf), np.full(len(last), -np.inf)

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
+from ..clip import clipped
 from ..follow import MAX_STEPS, STEP_M, walk_end
 from ..follow_inverse import Preimage, preimages
 from ..geometry import MapGeometry
@@ -233,7 +234,7 @@ def _on_curbs(geometry: MapGeometry, ex, ey, pre: Preimage, lines, margin: float
 def _inside(ex, ey, pre: Preimage, lines, domain: shapely.Geometry):
     """(D, x, y) of the candidate starts in a region or box: the middle of each preimage segment's
     first part inside it (a line, or a point where it only touches)."""
-    inside = shapely.intersection(lines, domain)
+    inside = clipped(lines, domain)
     hit = np.flatnonzero(~shapely.is_empty(inside))
     if not len(hit):
         return np.zeros(0), np.zeros(0), np.zeros(0)

@@ -22,8 +22,8 @@ from tests.scene.test_follow_start import town01_walks
 ANGLES = st.sampled_from([0.0, 1e-7, -1e-7, np.pi / 2, np.pi, -np.pi, 2 * np.pi - 1e-9, 3.0, np.nan])
 
 
-def boxes(draw, n: int) -> np.ndarray:
-    corner = np.array(draw(st.lists(st.tuples(*[st.integers(-40, 40)] * 2), min_size=n, max_size=n)), float).reshape(
+def boxes(draw, n: int, far: int = 40) -> np.ndarray:
+    corner = np.array(draw(st.lists(st.tuples(*[st.integers(-far, far)] * 2), min_size=n, max_size=n)), float).reshape(
         n, 2
     )
     size = np.array(draw(st.lists(st.tuples(*[st.integers(0, 20)] * 2), min_size=n, max_size=n)), float).reshape(n, 2)
@@ -34,21 +34,23 @@ def boxes(draw, n: int) -> np.ndarray:
 @given(st.data(), st.integers(0, 12), st.integers(0, 8))
 def test_near_heading_finds_every_item_near_in_heading_and_box_once(data, items, queries):
     """Brute force: every (query, item) whose boxes meet (closed) and one of whose headings lies within
-    WINDOW_RAD of the query's, modulo 2π (headings at the wrap, NaN columns, touching boxes)."""
+    the window (WINDOW_RAD, or the inverted walk's narrower ONLY_RAD) of the query's, modulo 2π
+    (headings at the wrap, NaN columns, touching boxes, queries beyond the items' extent)."""
     headings = np.array(data.draw(st.lists(st.tuples(ANGLES, ANGLES), min_size=items, max_size=items)), float)
     index = heading_index(headings.reshape(items, 2), boxes(data.draw, items))
     asked = np.array(data.draw(st.lists(ANGLES.filter(lambda a: a == a), min_size=queries, max_size=queries)), float)
-    where = boxes(data.draw, queries)
-    found = set(zip(*(a.tolist() for a in near_heading(index, asked, where))))
+    where = boxes(data.draw, queries, far=80)
+    window = data.draw(st.sampled_from([WINDOW_RAD, ONLY_RAD]))
+    found = list(zip(*(a.tolist() for a in near_heading(index, asked, where, window))))
     expected = {
         (q, i)
         for q in range(queries)
         for i in range(items)
         if np.all(where[q, :2] <= index.bounds[i, 2:])
         and np.all(index.bounds[i, :2] <= where[q, 2:])
-        and np.any(np.abs(_wrap(headings.reshape(items, 2)[i] - asked[q])) <= WINDOW_RAD)
+        and np.any(np.abs(_wrap(headings.reshape(items, 2)[i] - asked[q])) <= window)
     }
-    assert found == expected
+    assert sorted(found) == sorted(expected)
 
 
 def reference_crossings(lw, px, py, qx, qy, only=None):

@@ -77,6 +77,10 @@ from it than this (radians) are not looked at."""
 SLACK = 1e-9
 """Slack on a foot-of-perpendicular parameter when checking which distance piece holds."""
 
+PIECE_RANGE = np.array([[-np.inf, SLACK], [-SLACK, 1 + SLACK], [1 - SLACK, np.inf]])
+"""The range of the foot parameter in each distance piece (nearest to the start vertex, to the
+interior, to the end vertex), with slack."""
+
 
 @dataclass
 class Linework:
@@ -88,7 +92,9 @@ class Linework:
     as lines; an R-tree of where a lane's direction may count at all (each lane grown by Scenic's
     tolerance, and the intersection areas, where the nearest lane may count). For cuts for one
     heading (:func:`crossings` with ``only``): the area boundaries (indices into the segments) with
-    their own R-tree, and the vertex lines and the pairs indexed by heading."""
+    their own R-tree, and the vertex lines and the pairs indexed by heading in one index (items
+    0 .. len(start) - 1 the lines, by the headings either side; then the pairs, by their two
+    segments' headings), so that one lookup finds both."""
 
     start: np.ndarray
     end: np.ndarray
@@ -103,8 +109,7 @@ class Linework:
     lane_reach: shapely.STRtree
     boundary: np.ndarray
     boundary_tree: shapely.STRtree
-    line_index: HeadingIndex
-    pair_index: HeadingIndex
+    heading_items: HeadingIndex
 
 
 class _Columns:
@@ -171,8 +176,10 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
     lane_reach = shapely.STRtree(np.append(shapely.buffer(road_map.lane_polygons, ELEMENT_REACH_M), intersections))
     boundary = np.flatnonzero(np.isnan(side[:, 0]))
-    line_index = heading_index(side, shapely.bounds(tree.geometries))
-    pair_index = heading_index(polylines.heading[pairs], shapely.bounds(boxes))
+    heading_items = heading_index(
+        np.concatenate([side, polylines.heading[pairs].reshape(-1, 2)]),
+        np.concatenate([shapely.bounds(tree.geometries), shapely.bounds(boxes).reshape(-1, 4)]),
+    )
     return Linework(
         start,
         end,
@@ -187,8 +194,7 @@ def _build_linework(geometry: MapGeometry) -> Linework:
         lane_reach,
         boundary,
         shapely.STRtree(tree.geometries[boundary]),
-        line_index,
-        pair_index,
+        heading_items,
     )
 
 
@@ -246,24 +252,33 @@ def crossings(lw: Linework, px, py, qx, qy, only=None) -> tuple[np.ndarray, np.n
     segments = shapely.linestrings(np.stack([p, p + r], axis=1))
     if only is None:
         walk, line = lw.tree.query(segments)
+        pair_walk, pair = lw.pair_tree.query(segments)
     else:
-        walk, line = _lines_for(lw, p, r, segments, np.asarray(only)[index])
+        walk, line, pair_walk, pair = _near_only(lw, p, r, segments, np.asarray(only)[index])
     found_walk, found_t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
-    tie_walk, tie_t, _ = _ties(lw, p, r, segments, None if only is None else np.asarray(only)[index])
+    tie_walk, tie_t, _ = _ties(lw, p, r, pair_walk, pair)
     found_walk = np.concatenate([walk[found_walk], tie_walk])
     found_t = np.concatenate([found_t, tie_t])
     inside = (found_t > 0) & (found_t < 1)
     return index[found_walk[inside]], found_t[inside]
 
 
-def _lines_for(lw: Linework, p, r, segments, only) -> tuple[np.ndarray, np.ndarray]:
-    """(segment index, line index) of the linework lines whose boxes meet segment i's (as the
-    R-tree finds them) and that may change the heading to or from ``only[i]``: every area boundary,
-    and the vertex lines with a segment of that heading either side."""
+def _near_only(lw: Linework, p, r, segments, only) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(segment index, line index) of the linework lines and (segment index, pair index) of the
+    competing pairs whose boxes meet segment i's (as the R-tree finds them) and that may change the
+    heading to or from ``only[i]``: every area boundary, the vertex lines with a segment of that
+    heading either side, and the pairs one of whose segments has it (one heading-index lookup for
+    both)."""
     walk, edge = lw.boundary_tree.query(segments)
-    near_walk, line = near_heading(lw.line_index, only, _bounds(p, r))
-    near = np.any(np.abs(_wrap(lw.side[line] - only[near_walk][:, None])) <= ONLY_RAD, axis=1)
-    return np.concatenate([walk, near_walk[near]]), np.concatenate([lw.boundary[edge], line[near]])
+    near_walk, item = near_heading(lw.heading_items, only, _bounds(p, r), ONLY_RAD)
+    lines = item < len(lw.start)
+    line_walk, pair_walk = near_walk[lines], near_walk[~lines]
+    return (
+        np.concatenate([walk, line_walk]),
+        np.concatenate([lw.boundary[edge], item[lines]]),
+        pair_walk,
+        item[~lines] - len(lw.start),
+    )
 
 
 def _bounds(p: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -279,22 +294,15 @@ def ties(lw: Linework, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, 
     r = end - start
     moving = np.flatnonzero(np.hypot(r[:, 0], r[:, 1]) > DEGENERATE_M)
     p, r = start[moving], r[moving]
-    walk, t, pair = _ties(lw, p, r, shapely.linestrings(np.stack([p, p + r], axis=1)))
+    walk, t, pair = _ties(lw, p, r, *lw.pair_tree.query(shapely.linestrings(np.stack([p, p + r], axis=1))))
     inside = (t > 0) & (t < 1)
     walk, pair = moving[walk[inside]], pair[inside]
     return np.concatenate([walk, walk]), np.concatenate([lw.pairs[pair, 0], lw.pairs[pair, 1]])
 
 
-def _ties(lw: Linework, p: np.ndarray, r: np.ndarray, segments: np.ndarray, only=None):
-    """(segment index, t, pair index) where the two segments of a competing pair are equally near
-    p + t r (with ``only``: pairs one of whose segments has heading ``only[segment index]``)."""
-    if only is None:
-        walk, pair = lw.pair_tree.query(segments)
-    else:
-        walk, pair = near_heading(lw.pair_index, only, _bounds(p, r))
-        heading = lw.polylines.heading[lw.pairs[pair]]
-        mine = np.any(np.abs(_wrap(heading - only[walk][:, None])) <= ONLY_RAD, axis=1)
-        walk, pair = walk[mine], pair[mine]
+def _ties(lw: Linework, p: np.ndarray, r: np.ndarray, walk: np.ndarray, pair: np.ndarray):
+    """(segment index, t, pair index) where the two segments of the competing pair ``pair[h]`` are
+    equally near p + t r (of segment ``walk[h]``)."""
     if not len(pair):
         return walk, np.zeros(0), pair
     tie_t, tie = _equal_distances(lw, p[walk], r[walk], pair)
@@ -325,29 +333,26 @@ def _distance_pieces(polylines: Polylines, segment: np.ndarray, p, r) -> tuple[n
     rr = np.einsum("ij,ij->i", r, r)
     pa, pb = p - a, p - a - w
     cw, cr = _cross(pa, w), _cross(r, w)
+    dot = np.einsum("ij,ij->i", np.concatenate([pa, pa, pb, pb, pa, r]), np.concatenate([r, pa, r, pb, w, w]))
+    pa_r, pa_pa, pb_r, pb_pb, pa_w, r_w = dot.reshape(6, -1)
     quads = np.stack(
-        [
-            np.stack([rr, 2 * np.einsum("ij,ij->i", pa, r), np.einsum("ij,ij->i", pa, pa)], 1),
-            np.stack([cr * cr / ll, 2 * cw * cr / ll, cw * cw / ll], 1),
-            np.stack([rr, 2 * np.einsum("ij,ij->i", pb, r), np.einsum("ij,ij->i", pb, pb)], 1),
-        ],
-        1,
-    )
-    return quads, np.stack([np.einsum("ij,ij->i", pa, w) / ll, np.einsum("ij,ij->i", r, w) / ll], 1)
+        [rr, 2 * pa_r, pa_pa, cr * cr / ll, 2 * cw * cr / ll, cw * cw / ll, rr, 2 * pb_r, pb_pb], 1
+    ).reshape(-1, 3, 3)
+    return quads, np.stack([pa_w / ll, r_w / ll], 1)
 
 
 def _equal_distances(lw: Linework, p, r, pair) -> tuple[np.ndarray, np.ndarray]:
     """(t, hit index) where the two segments of ``pair[h]`` are equally near p + t r, within their
     lane's reach, and no segment of their centreline is nearer (where the nearest segment may jump
     between them)."""
-    i, j = lw.pairs[pair, 0], lw.pairs[pair, 1]
-    qi, si = _distance_pieces(lw.polylines, i, p, r)
-    qj, sj = _distance_pieces(lw.polylines, j, p, r)
+    n = len(pair)
+    quads, foot = _distance_pieces(lw.polylines, lw.pairs[pair].T.ravel(), np.tile(p, (2, 1)), np.tile(r, (2, 1)))
+    qi, qj = quads[:n], quads[n:]
     diff = qi[:, :, None, :] - qj[:, None, :, :]
     roots = _quadratic_roots(diff[..., 0], diff[..., 1], diff[..., 2])
     hit, piece_i, piece_j, _ = np.nonzero((roots > 0) & (roots < 1))
     t = roots[hit, piece_i, piece_j, _]
-    valid = _in_piece(si[hit], piece_i, t) & _in_piece(sj[hit], piece_j, t)
+    valid = _in_piece(foot[hit], piece_i, t) & _in_piece(foot[n + hit], piece_j, t)
     hit, piece_i, t = hit[valid], piece_i[valid], t[valid]
     quad = qi[hit, piece_i]
     own = np.sqrt(np.maximum(quad[:, 0] * t * t + quad[:, 1] * t + quad[:, 2], 0.0))
@@ -366,9 +371,8 @@ def _wrap(angle: np.ndarray) -> np.ndarray:
 def _in_piece(s: np.ndarray, piece: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Whether the foot parameter s0 + s1 t lies in the range of the distance piece (with slack)."""
     foot = s[:, 0] + s[:, 1] * t
-    return np.where(
-        piece == 0, foot <= SLACK, np.where(piece == 1, (foot >= -SLACK) & (foot <= 1 + SLACK), foot >= 1 - SLACK)
-    )
+    low, high = PIECE_RANGE[piece].T
+    return (foot >= low) & (foot <= high)
 
 
 def _quadratic_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:

@@ -3,14 +3,19 @@
 The inverted walk (:mod:`.follow_inverse`) cuts a swept segment only where the field may change to
 or from the heading it tries (:func:`.follow_pieces.crossings` with ``only``): of the vertex lines
 and competing pairs whose boxes meet the segment, it keeps the few with that heading. An R-tree
-query returns all of them first (tens per segment near curves and intersections, a hundred
-thousand per step). This index files each item under (heading bin, grid cell) keys, one per bin
-its heading's neighbourhood (within twice :data:`WINDOW_RAD`) touches times each cell of
-:data:`CELL_M` its box touches, sorted; a query looks up its heading's bin and its box's cells
-(one binary search per key) and keeps each item once whose box meets the query's (closed
-intervals, as the R-tree's envelope test) and whose heading lies within :data:`WINDOW_RAD`
-(modulo 2π). The caller applies its own, narrower heading test to what is returned: together
-they find exactly what the R-tree query and that test find.
+query over the plain boxes returns all of them first (tens per segment near curves and
+intersections, a hundred thousand per step). This index files each item once under every heading
+bin its headings' neighbourhoods (within twice :data:`WINDOW_RAD`) touch, in one R-tree over a
+plane of strips, one per bin: bin b's boxes are shifted along x by b strip widths (a strip is
+wider than the items' extent by twice :data:`MARGIN_M`). A query's box, its x range clipped to
+the items' extent (widened by half the margin, so it meets the same items) and shifted to its
+heading's bin, meets only boxes of that bin. The tree's boxes are grown by a slack larger than the
+rounding of the shifted coordinates, so the tree returns a superset; a query then keeps each item
+whose box meets its own (closed intervals on the unshifted coordinates, as the R-tree's envelope
+test) and one of whose headings lies within the caller's window of it (at most
+:data:`WINDOW_RAD`, modulo 2π): exactly what the R-tree query followed by that heading test
+finds. One lookup serves any mix of items (the inverted walk files vertex
+lines and competing pairs in one index).
 """
 
 from __future__ import annotations
@@ -18,95 +23,86 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import shapely
 
 WINDOW_RAD = 1e-5
-"""Items whose heading differs from the asked one by at most this (radians, modulo 2π) are returned:
-wider than :data:`.follow_pieces.ONLY_RAD`, so that rounding cannot lose one."""
+"""The widest heading window a lookup may ask for (radians, modulo 2π): items are filed under every
+bin within twice this of a heading of theirs, so that rounding in the binning cannot lose one
+(:data:`.follow_pieces.ONLY_RAD` is narrower)."""
 
 BINS = 2048
 """Heading bins (each 2π / BINS radians wide)."""
 
-CELL_M = 8.0
-"""Grid cell side (metres)."""
+MARGIN_M = 1.0
+"""Space left between the strips of neighbouring bins, either side of the items' extent (metres)."""
+
+SLACK_M = 1e-6
+"""Growth of the tree's boxes beyond the rounding of the shifted coordinates (metres)."""
 
 
 @dataclass
 class HeadingIndex:
-    """Items filed by key ``(bin * nx + cx) * ny + cy`` (``key`` sorted, ``item`` each key's item;
-    cells counted from ``origin``, ``nx`` by ``ny``), with each item's heading columns ``heading``
-    (radians, NaN: none) and box ``bounds`` (rows of x_min, y_min, x_max, y_max; metres)."""
+    """Items filed in ``tree`` (entry k: item ``item[k]``, its box shifted by its bin's strip, see
+    the module docstring), with each item's heading columns ``heading`` (radians, NaN: none) and
+    box ``bounds`` (rows of x_min, y_min, x_max, y_max; metres). A query's x range is clipped to
+    [``low``, ``high``] and shifted by ``shift`` plus its bin times ``width`` (metres)."""
 
-    key: np.ndarray
+    tree: shapely.STRtree
     item: np.ndarray
     heading: np.ndarray
     bounds: np.ndarray
-    origin: np.ndarray
-    nx: int
-    ny: int
+    low: float
+    high: float
+    shift: float
+    width: float
 
 
 def heading_index(headings: np.ndarray, bounds: np.ndarray) -> HeadingIndex:
-    """The index of items with headings ``headings[i]`` (a row of columns; NaN: none) and boxes
-    ``bounds[i]``."""
+    """The index of items with headings ``headings[i]`` (a row of columns, 2-D; NaN: none) and
+    boxes ``bounds[i]`` (finite)."""
     bounds = np.asarray(bounds, dtype=float).reshape(-1, 4)
     headings = np.asarray(headings, dtype=float)
-    origin = bounds[:, :2].min(axis=0, initial=0.0) if len(bounds) else np.zeros(2)
-    size = np.floor((bounds[:, 2:].max(axis=0, initial=0.0) - origin) / CELL_M).astype(np.int64) + 1
+    low = float(bounds[:, 0].min(initial=0.0))
+    high = float(bounds[:, 2].max(initial=0.0))
+    width = high - low + 2 * MARGIN_M
+    shift = MARGIN_M - low
+    slack = SLACK_M + 64 * float(np.spacing(BINS * width + abs(shift)))
     item, column = np.nonzero(~np.isnan(headings))
     angle = np.mod(headings[item, column], 2 * np.pi)
-    low, high = _bin(angle - 2 * WINDOW_RAD), _bin(angle + 2 * WINDOW_RAD)
-    item, first = _expand(item, low, high)
-    heading_bin = np.mod(first, BINS)
-    cells = _cells(bounds[item], origin)
-    index = HeadingIndex(np.zeros(0, np.int64), np.zeros(0, np.intp), headings, bounds, origin, *size.tolist())
-    owner, key = _keys(index, heading_bin, cells)
-    order = np.argsort(key, kind="stable")
-    index.key, index.item = key[order], item[owner][order]
-    return index
+    item, first = _expand(item, _bin(angle - 2 * WINDOW_RAD), _bin(angle + 2 * WINDOW_RAD))
+    filed = np.unique(item.astype(np.int64) * BINS + np.mod(first, BINS))
+    item, offset = (filed // BINS).astype(np.intp), (filed % BINS) * width + shift
+    box = bounds[item]
+    tree = shapely.STRtree(
+        shapely.box(box[:, 0] + offset - slack, box[:, 1] - slack, box[:, 2] + offset + slack, box[:, 3] + slack)
+    )
+    half = MARGIN_M / 2
+    return HeadingIndex(tree, item, headings, bounds, low - half, high + half, shift, width)
 
 
-def near_heading(index: HeadingIndex, heading: np.ndarray, bounds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(query, item) pairs, each once: item's heading within :data:`WINDOW_RAD` of ``heading[query]``
-    (radians, modulo 2π) and its box meeting ``bounds[query]`` (rows of x_min, y_min, x_max, y_max)."""
-    bounds = np.asarray(bounds, dtype=float)
+def near_heading(
+    index: HeadingIndex, heading: np.ndarray, bounds: np.ndarray, window: float = WINDOW_RAD
+) -> tuple[np.ndarray, np.ndarray]:
+    """(query, item) pairs, each once: one of item's headings within ``window`` (radians, at most
+    :data:`WINDOW_RAD`) of ``heading[query]`` (radians, finite), modulo 2π (the turn from one to
+    the other wrapped to [-π, π), as ``(d + π) % 2π - π``), and its box meeting ``bounds[query]``
+    (rows of x_min, y_min, x_max, y_max; closed intervals)."""
+    bounds = np.asarray(bounds, dtype=float).reshape(-1, 4)
     heading = np.asarray(heading, dtype=float)
-    query, key = _keys(index, np.mod(_bin(np.mod(heading, 2 * np.pi)), BINS), _cells(bounds, index.origin))
-    first = np.searchsorted(index.key, key, side="left")
-    last = np.searchsorted(index.key, key, side="right")
-    query, at = _expand(query, first, last - 1)
-    item = index.item[at]
+    offset = np.mod(_bin(np.mod(heading, 2 * np.pi)), BINS) * index.width + index.shift
+    x = np.clip(bounds[:, 0::2], index.low, index.high) + offset[:, None]
+    query, entry = index.tree.query(shapely.box(x[:, 0], bounds[:, 1], x[:, 1], bounds[:, 3]))
+    item = index.item[entry]
     mine, theirs = bounds[query], index.bounds[item]
     meet = np.all((mine[:, :2] <= theirs[:, 2:]) & (theirs[:, :2] <= mine[:, 2:]), axis=1)
     turn = np.abs(np.mod(index.heading[item] - heading[query][:, None] + np.pi, 2 * np.pi) - np.pi)
-    keep = meet & np.any(turn <= WINDOW_RAD, axis=1)
-    query, item = query[keep], item[keep]
-    size = np.int64(len(index.bounds))
-    unique = np.unique(query.astype(np.int64) * size + item)
-    return (unique // max(size, 1)).astype(np.intp), (unique % max(size, 1)).astype(np.intp)
+    keep = np.flatnonzero(meet & np.any(turn <= window, axis=1))
+    return query[keep], item[keep]
 
 
 def _bin(angle: np.ndarray) -> np.ndarray:
     """The heading bin of each angle (radians), not yet wrapped."""
     return np.floor(angle * (BINS / (2 * np.pi))).astype(np.int64)
-
-
-def _cells(bounds: np.ndarray, origin: np.ndarray) -> np.ndarray:
-    """Each box's cell ranges (rows of cx_lo, cy_lo, cx_hi, cy_hi; clipped to the grid by the caller)."""
-    low = np.floor((bounds[:, :2] - origin) / CELL_M)
-    high = np.floor((bounds[:, 2:] - origin) / CELL_M)
-    return np.concatenate([low, high], axis=1)
-
-
-def _keys(index: HeadingIndex, heading_bin: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(row, key) for every grid cell of each row's cell ranges (clipped to the grid) in its bin."""
-    top = np.array([index.nx - 1, index.ny - 1], dtype=float)
-    low = np.clip(cells[:, :2], 0, top).astype(np.int64)
-    high = np.minimum(cells[:, 2:], top).astype(np.int64)
-    high = np.where(cells[:, 2:] < 0, -1, high)
-    row, cx = _expand(np.arange(len(cells)), low[:, 0], high[:, 0])
-    at, cy = _expand(np.arange(len(row)), low[row, 1], high[row, 1])
-    row = row[at]
-    return row, (heading_bin[row] * index.nx + cx[at]) * index.ny + cy
 
 
 def _expand(owner: np.ndarray, low: np.ndarray, high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

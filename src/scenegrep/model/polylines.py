@@ -48,11 +48,15 @@ class Polylines:
     def __len__(self) -> int:
         return len(self.lines)
 
-    def segment_at(self, line: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    def segment_at(
+        self, line: np.ndarray, x: np.ndarray, y: np.ndarray, points: np.ndarray | None = None
+    ) -> np.ndarray:
         """Index (into the flat segment arrays) of the segment of polyline ``line[i]`` nearest
-        to point i, by projection (Scenic's rule)."""
+        to point i, by projection (Scenic's rule); ``points``: the points as shapely points, when
+        the caller has them."""
         line = np.asarray(line, dtype=np.intp)
-        arc = shapely.line_locate_point(self.geometries[line], shapely.points(x, y))
+        points = shapely.points(x, y) if points is None else points
+        arc = shapely.line_locate_point(self.geometries[line], points)
         low, high = self.first[line], self.first[line] + np.maximum(self.count[line] - 1, 0)
         found = np.clip(np.searchsorted(self.arc_end, arc + self.base[line], side="left"), low, high)
         # the global search can be off by one at ties; settle them on the per-line arc lengths,
@@ -62,11 +66,14 @@ class Polylines:
         following = np.minimum(found + 1, high)
         return np.where((found < high) & (arc > self.local_end[found]), following, found)
 
-    def direction_at(self, line: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        """Heading (radians) of polyline ``line[i]`` at point i (its nearest segment's heading)."""
+    def direction_at(
+        self, line: np.ndarray, x: np.ndarray, y: np.ndarray, points: np.ndarray | None = None
+    ) -> np.ndarray:
+        """Heading (radians) of polyline ``line[i]`` at point i (its nearest segment's heading);
+        ``points`` as in :meth:`segment_at`."""
         if len(np.atleast_1d(line)) == 0:
             return np.zeros(0)
-        return self.heading[self.segment_at(line, x, y)]
+        return self.heading[self.segment_at(line, x, y, points)]
 
 
 def _without_repeats(points: np.ndarray) -> np.ndarray:

@@ -347,11 +347,13 @@ def _equal_distances(lw: Linework, p, r, pair) -> tuple[np.ndarray, np.ndarray]:
     between them)."""
     n = len(pair)
     quads, foot = _distance_pieces(lw.polylines, lw.pairs[pair].T.ravel(), np.tile(p, (2, 1)), np.tile(r, (2, 1)))
-    qi, qj = quads[:n], quads[n:]
-    diff = qi[:, :, None, :] - qj[:, None, :, :]
-    roots = _quadratic_roots(diff[..., 0], diff[..., 1], diff[..., 2])
-    hit, piece_i, piece_j, _ = np.nonzero((roots > 0) & (roots < 1))
-    t = roots[hit, piece_i, piece_j, _]
+    qi = quads[:n]
+    coefficient = np.moveaxis(quads, 2, 0)
+    a, b, c = coefficient[:, :n, :, None] - coefficient[:, n:, None, :]
+    roots = _quadratic_roots(a, b, c)
+    flat = np.flatnonzero((roots > 0) & (roots < 1))
+    t = roots.reshape(-1)[flat]
+    hit, piece_i, piece_j = flat // 18, flat // 6 % 3, flat // 2 % 3
     valid = _in_piece(foot[hit], piece_i, t) & _in_piece(foot[n + hit], piece_j, t)
     hit, piece_i, t = hit[valid], piece_i[valid], t[valid]
     quad = qi[hit, piece_i]
@@ -378,8 +380,8 @@ def _in_piece(s: np.ndarray, piece: np.ndarray, t: np.ndarray) -> np.ndarray:
 def _quadratic_roots(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     """The real roots of a t² + b t + c (shape (..., 2); NaN where absent)."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        scale = np.abs(a) + np.abs(b) + np.abs(c)
-        linear = np.abs(a) <= 1e-12 * scale
+        size = np.abs(a)
+        linear = size <= 1e-12 * (size + np.abs(b) + np.abs(c))
         disc = b * b - 4 * a * c
         q = -(b + np.copysign(np.sqrt(np.where(disc >= 0, disc, np.nan)), b)) / 2
         first = np.where(linear, -c / b, q / a)

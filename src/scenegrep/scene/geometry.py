@@ -70,6 +70,10 @@ ELEMENT_REACH_M = 0.05
 or crossing takes the direction of the first within this distance (Scenic's union of them is
 built with this buffer, and its orientation tries that tolerance next)."""
 
+NEAR_M = ELEMENT_REACH_M + 1e-6
+"""Points with no lane within this (metres; Scenic's tolerance, and slack for rounding) have no
+lane within the tolerance: the nearest lane is not looked up for them."""
+
 GEOMETRY_CACHE_SIZE = 8
 """How many road maps' geometries :func:`geometry_of` keeps (least recently used dropped)."""
 
@@ -469,7 +473,9 @@ class MapGeometry:
         lanes = [[index[lane] for lane in a.lanes if lane in index] for a in areas]
         starts = np.concatenate([[0], np.cumsum([len(group) for group in lanes])]).astype(np.intp)
         flat = np.array([lane for group in lanes for lane in group], dtype=np.intp)
-        return STRtree(np.array([a.polygon for a in areas], dtype=object)), flat, starts
+        polygons = np.array([a.polygon for a in areas], dtype=object)
+        shapely.prepare(polygons)
+        return STRtree(polygons), flat, starts
 
     def scenic_headings(self, field: Field, x: np.ndarray, y: np.ndarray, value: Values) -> np.ndarray:
         """The one heading Scenic itself computes for the field at each point (used to walk along it).
@@ -493,7 +499,7 @@ class MapGeometry:
         lane = np.full(len(x), -1, dtype=np.intp)
         if len(x):
             if len(road_map.lanes):
-                rows, lanes = _first_per_point(*road_map._lane_tree.query(points, predicate="intersects"))
+                rows, lanes = _first_per_point(*_containing(road_map._lane_tree, points))
                 lane[rows] = lanes
             self._intersection_choice(points, lane)
         chosen = np.zeros(len(x))
@@ -501,7 +507,7 @@ class MapGeometry:
         if len(off):
             chosen[off] = self._off_lanes(x[off], y[off], points[off])
         on = np.flatnonzero(lane >= 0)
-        chosen[on] = road_map.centreline_polylines.direction_at(lane[on], x[on], y[on])
+        chosen[on] = road_map.centreline_polylines.direction_at(lane[on], x[on], y[on], points[on])
         return chosen
 
     @cached_property
@@ -511,7 +517,9 @@ class MapGeometry:
         areas = self._require_map().shoulders
         if not areas or any(a.centreline is None for a in areas):
             return None
-        return STRtree(np.array([a.polygon for a in areas], dtype=object)), Polylines([a.centreline for a in areas])
+        polygons = np.array([a.polygon for a in areas], dtype=object)
+        shapely.prepare(polygons)
+        return STRtree(polygons), Polylines([a.centreline for a in areas])
 
     def _off_lanes(self, x: np.ndarray, y: np.ndarray, points: np.ndarray | None = None) -> np.ndarray:
         """Scenic's road direction at points in no lane and no intersection area: the first shoulder
@@ -524,26 +532,33 @@ class MapGeometry:
         points = shapely.points(x, y) if points is None else points
         shoulders = self._shoulders
         if shoulders is not None:
-            point, shoulder = _first_per_point(*shoulders[0].query(points, predicate="intersects"))
-            chosen[point] = shoulders[1].direction_at(shoulder, x[point], y[point])
-            rest = np.setdiff1d(np.arange(len(x)), point)
+            point, shoulder = _first_per_point(*_containing(shoulders[0], points))
+            chosen[point] = shoulders[1].direction_at(shoulder, x[point], y[point], points[point])
+            elsewhere = np.ones(len(x), dtype=bool)
+            elsewhere[point] = False
+            rest = np.flatnonzero(elsewhere)
         else:
             rest = np.arange(len(x))
         lane = np.full(len(rest), -1, dtype=np.intp)
         if len(rest):
             self._intersection_choice(points[rest], lane, ELEMENT_REACH_M)
-        free = np.flatnonzero(lane < 0)
-        if len(free) and len(road_map.lanes):
+        free = np.flatnonzero(lane < 0) if len(road_map.lanes) else np.zeros(0, np.intp)
+        if len(free):
+            close = road_map._lane_tree.query(points[rest[free]], predicate="dwithin", distance=NEAR_M)[0]
+            free = free[np.unique(close)]
+        if len(free):
             nearest = road_map._lane_tree.nearest(points[rest[free]])
             near = shapely.distance(road_map.lane_polygons[nearest], points[rest[free]]) <= ELEMENT_REACH_M
             lane[free[near]] = nearest[near]
         on = np.flatnonzero(lane >= 0)
-        chosen[rest[on]] = road_map.centreline_polylines.direction_at(lane[on], x[rest[on]], y[rest[on]])
+        chosen[rest[on]] = road_map.centreline_polylines.direction_at(
+            lane[on], x[rest[on]], y[rest[on]], points[rest[on]]
+        )
         free = rest[lane < 0]
         if len(free) and shoulders is not None:
             tree, lines = shoulders
             point, shoulder = _first_per_point(*tree.query(points[free], predicate="dwithin", distance=ELEMENT_REACH_M))
-            chosen[free[point]] = lines.direction_at(shoulder, x[free[point]], y[free[point]])
+            chosen[free[point]] = lines.direction_at(shoulder, x[free[point]], y[free[point]], points[free[point]])
         return chosen
 
     def _intersection_choice(self, points: np.ndarray, lane: np.ndarray, reach: float = 0.0) -> None:
@@ -557,7 +572,7 @@ class MapGeometry:
         if reach > 0:
             point, area = tree.query(points, predicate="dwithin", distance=reach)
         else:
-            point, area = tree.query(points, predicate="intersects")
+            point, area = _containing(tree, points)
         if not len(point):
             return
         point, area = _first_per_point(point, area)
@@ -568,7 +583,9 @@ class MapGeometry:
         here = points[point[group]]
         score = np.where(shapely.intersects(road_map.lane_polygons[candidates], here), -1.0, 0.0)
         outside = np.flatnonzero(score == 0)
-        outside = outside[~np.isin(group[outside], group[score < 0])]
+        inside = np.zeros(len(point), dtype=bool)
+        inside[group[score < 0]] = True
+        outside = outside[~inside[group[outside]]]
         score[outside] = shapely.distance(road_map.lane_polygons[candidates[outside]], here[outside])
         order = np.lexsort((position, score, group))
         best = order[_firsts(group[order])]
@@ -645,6 +662,16 @@ def _firsts(rows: np.ndarray) -> np.ndarray:
     first = np.ones(len(rows), dtype=bool)
     first[1:] = rows[1:] != rows[:-1]
     return first
+
+
+def _containing(tree: STRtree, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(point, geometry) pairs where the tree's geometry intersects the point (shapely points),
+    as ``tree.query(points, predicate="intersects")`` finds them: the R-tree's box candidates
+    tested against the tree's geometries, prepared by its builder (the tree's own predicate
+    prepares the points instead, and tests each polygon's every edge)."""
+    point, found = tree.query(points)
+    hit = shapely.intersects(tree.geometries[found], points[point])
+    return point[hit], found[hit]
 
 
 def _first_per_point(point: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -91,10 +91,10 @@ class Linework:
     R-tree of the boxes where they may (within the lane's reach of both); the centreline segments
     as lines; an R-tree of where a lane's direction may count at all (each lane grown by Scenic's
     tolerance, and the intersection areas, where the nearest lane may count). For cuts for one
-    heading (:func:`crossings` with ``only``): the area boundaries (indices into the segments) with
-    their own R-tree, and the vertex lines and the pairs indexed by heading in one index (items
-    0 .. len(start) - 1 the lines, by the headings either side; then the pairs, by their two
-    segments' headings), so that one lookup finds both."""
+    heading (:func:`crossings` with ``only``): the lines and the pairs in one heading index (items
+    0 .. len(start) - 1 the lines: the area boundaries for every heading, the vertex lines by the
+    headings either side; then the pairs, by their two segments' headings), so that one lookup
+    finds all three."""
 
     start: np.ndarray
     end: np.ndarray
@@ -107,8 +107,6 @@ class Linework:
     polylines: Polylines
     segments: np.ndarray
     lane_reach: shapely.STRtree
-    boundary: np.ndarray
-    boundary_tree: shapely.STRtree
     heading_items: HeadingIndex
 
 
@@ -175,10 +173,10 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     near = reach[lanes] + REACH_MARGIN_M
     segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
     lane_reach = shapely.STRtree(np.append(shapely.buffer(road_map.lane_polygons, ELEMENT_REACH_M), intersections))
-    boundary = np.flatnonzero(np.isnan(side[:, 0]))
     heading_items = heading_index(
         np.concatenate([side, polylines.heading[pairs].reshape(-1, 2)]),
         np.concatenate([shapely.bounds(tree.geometries), shapely.bounds(boxes).reshape(-1, 4)]),
+        np.concatenate([np.isnan(side[:, 0]), np.zeros(len(pairs), dtype=bool)]),
     )
     return Linework(
         start,
@@ -192,8 +190,6 @@ def _build_linework(geometry: MapGeometry) -> Linework:
         polylines,
         segments,
         lane_reach,
-        boundary,
-        shapely.STRtree(tree.geometries[boundary]),
         heading_items,
     )
 
@@ -249,12 +245,12 @@ def crossings(lw: Linework, px, py, qx, qy, only=None) -> tuple[np.ndarray, np.n
         return np.zeros(0, np.intp), np.zeros(0)
     p = np.stack([px, py], 1)[index]
     r = np.stack([qx, qy], 1)[index] - p
-    segments = shapely.linestrings(np.stack([p, p + r], axis=1))
     if only is None:
+        segments = shapely.linestrings(np.stack([p, p + r], axis=1))
         walk, line = lw.tree.query(segments)
         pair_walk, pair = lw.pair_tree.query(segments)
     else:
-        walk, line, pair_walk, pair = _near_only(lw, p, r, segments, np.asarray(only)[index])
+        walk, line, pair_walk, pair = _near_only(lw, p, r, np.asarray(only)[index])
     found_walk, found_t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
     tie_walk, tie_t, _ = _ties(lw, p, r, pair_walk, pair)
     found_walk = np.concatenate([walk[found_walk], tie_walk])
@@ -263,22 +259,15 @@ def crossings(lw: Linework, px, py, qx, qy, only=None) -> tuple[np.ndarray, np.n
     return index[found_walk[inside]], found_t[inside]
 
 
-def _near_only(lw: Linework, p, r, segments, only) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _near_only(lw: Linework, p, r, only) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(segment index, line index) of the linework lines and (segment index, pair index) of the
     competing pairs whose boxes meet segment i's (as the R-tree finds them) and that may change the
     heading to or from ``only[i]``: every area boundary, the vertex lines with a segment of that
     heading either side, and the pairs one of whose segments has it (one heading-index lookup for
-    both)."""
-    walk, edge = lw.boundary_tree.query(segments)
-    near_walk, item = near_heading(lw.heading_items, only, _bounds(p, r), ONLY_RAD)
+    all three)."""
+    walk, item = near_heading(lw.heading_items, only, _bounds(p, r), ONLY_RAD)
     lines = item < len(lw.start)
-    line_walk, pair_walk = near_walk[lines], near_walk[~lines]
-    return (
-        np.concatenate([walk, line_walk]),
-        np.concatenate([lw.boundary[edge], item[lines]]),
-        pair_walk,
-        item[~lines] - len(lw.start),
-    )
+    return walk[lines], item[lines], walk[~lines], item[~lines] - len(lw.start)
 
 
 def _bounds(p: np.ndarray, r: np.ndarray) -> np.ndarray:
@@ -329,15 +318,16 @@ def _distance_pieces(polylines: Polylines, segment: np.ndarray, p, r) -> tuple[n
     the segment parameter of the foot of the perpendicular, (s0, s1) with s = s0 + s1 t."""
     a = polylines.start[segment]
     w = polylines.end[segment] - a
-    ll = np.einsum("ij,ij->i", w, w)
-    rr = np.einsum("ij,ij->i", r, r)
-    pa, pb = p - a, p - a - w
-    cw, cr = _cross(pa, w), _cross(r, w)
-    dot = np.einsum("ij,ij->i", np.concatenate([pa, pa, pb, pb, pa, r]), np.concatenate([r, pa, r, pb, w, w]))
-    pa_r, pa_pa, pb_r, pb_pb, pa_w, r_w = dot.reshape(6, -1)
-    quads = np.stack(
-        [rr, 2 * pa_r, pa_pa, cr * cr / ll, 2 * cw * cr / ll, cw * cw / ll, rr, 2 * pb_r, pb_pb], 1
-    ).reshape(-1, 3, 3)
+    pa = p - a
+    pb = pa - w
+    left, right = np.concatenate([w, r, pa, pa, pb, pb, pa, r]), np.concatenate([w, r, r, pa, r, pb, w, w])
+    ll, rr, pa_r, pa_pa, pb_r, pb_pb, pa_w, r_w = (left[:, 0] * right[:, 0] + left[:, 1] * right[:, 1]).reshape(8, -1)
+    cw, cr = _cross(np.concatenate([pa, r]), np.concatenate([w, w])).reshape(2, -1)
+    quads = np.empty((len(a), 3, 3))
+    quads[:, 0, 0] = quads[:, 2, 0] = rr
+    quads[:, 0, 1], quads[:, 0, 2] = 2 * pa_r, pa_pa
+    quads[:, 1, 0], quads[:, 1, 1], quads[:, 1, 2] = cr * cr / ll, 2 * cw * cr / ll, cw * cw / ll
+    quads[:, 2, 1], quads[:, 2, 2] = 2 * pb_r, pb_pb
     return quads, np.stack([pa_w / ll, r_w / ll], 1)
 
 

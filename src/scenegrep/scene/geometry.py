@@ -498,10 +498,13 @@ class MapGeometry:
         points = shapely.points(x, y)
         lane = np.full(len(x), -1, dtype=np.intp)
         if len(x):
+            inside = np.zeros(0, np.int64)
             if len(road_map.lanes):
-                rows, lanes = _first_per_point(*_containing(road_map._lane_tree, points))
+                rows, lanes = _containing(road_map._lane_tree, points)
+                inside = np.sort(rows * np.int64(len(road_map.lanes)) + lanes)
+                rows, lanes = _first_per_point(rows, lanes)
                 lane[rows] = lanes
-            self._intersection_choice(points, lane)
+            self._intersection_choice(points, lane, 0.0, inside)
         chosen = np.zeros(len(x))
         off = np.flatnonzero(lane < 0)
         if len(off):
@@ -541,7 +544,7 @@ class MapGeometry:
             rest = np.arange(len(x))
         lane = np.full(len(rest), -1, dtype=np.intp)
         if len(rest):
-            self._intersection_choice(points[rest], lane, ELEMENT_REACH_M)
+            self._intersection_choice(points[rest], lane, ELEMENT_REACH_M, np.zeros(0, np.int64))
         free = np.flatnonzero(lane < 0) if len(road_map.lanes) else np.zeros(0, np.intp)
         if len(free):
             close = road_map._lane_tree.query(points[rest[free]], predicate="dwithin", distance=NEAR_M)[0]
@@ -561,10 +564,11 @@ class MapGeometry:
             chosen[free[point]] = lines.direction_at(shoulder, x[free[point]], y[free[point]], points[free[point]])
         return chosen
 
-    def _intersection_choice(self, points: np.ndarray, lane: np.ndarray, reach: float = 0.0) -> None:
+    def _intersection_choice(self, points: np.ndarray, lane: np.ndarray, reach: float, inside: np.ndarray) -> None:
         """Points (shapely) in an intersection area (or within ``reach`` metres of one) take the first
         of its lanes containing them, else the nearest (the first such intersection area counts):
-        set in ``lane``."""
+        set in ``lane``. ``inside``: every lane containing each point, as ``point * lanes + lane``
+        sorted (the caller has found them; none for points in no lane)."""
         road_map = self._require_map()
         tree, flat, starts = self._intersection_areas
         if not len(flat):
@@ -581,7 +585,9 @@ class MapGeometry:
         position = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
         candidates = flat[starts[area][group] + position]
         here = points[point[group]]
-        score = np.where(shapely.intersects(road_map.lane_polygons[candidates], here), -1.0, 0.0)
+        code = point[group] * np.int64(len(road_map.lanes)) + candidates
+        at = np.minimum(np.searchsorted(inside, code), max(len(inside) - 1, 0))
+        score = np.where(inside[at] == code, -1.0, 0.0) if len(inside) else np.zeros(len(code))
         outside = np.flatnonzero(score == 0)
         inside = np.zeros(len(point), dtype=bool)
         inside[group[score < 0]] = True

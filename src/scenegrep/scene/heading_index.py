@@ -14,8 +14,9 @@ rounding of the shifted coordinates, so the tree returns a superset; a query the
 whose box meets its own (closed intervals on the unshifted coordinates, as the R-tree's envelope
 test) and one of whose headings lies within the caller's window of it (at most
 :data:`WINDOW_RAD`, modulo 2π): exactly what the R-tree query followed by that heading test
-finds. One lookup serves any mix of items (the inverted walk files vertex
-lines and competing pairs in one index).
+finds. Items wanted for every heading (the inverted walk's area boundaries) are filed once in one
+more strip, which every query also looks up. One lookup serves any mix of items (the inverted
+walk files area boundaries, vertex lines and competing pairs in one index).
 """
 
 from __future__ import annotations
@@ -43,12 +44,14 @@ SLACK_M = 1e-6
 @dataclass
 class HeadingIndex:
     """Items filed in ``tree`` (entry k: item ``item[k]``, its box shifted by its bin's strip, see
-    the module docstring), with each item's heading columns ``heading`` (radians, NaN: none) and
-    box ``bounds`` (rows of x_min, y_min, x_max, y_max; metres). A query's x range is clipped to
-    [``low``, ``high``] and shifted by ``shift`` plus its bin times ``width`` (metres)."""
+    the module docstring; ``everywhere[k]``: filed in the strip after the last bin's, found for
+    every heading), with each item's heading columns ``heading`` (radians, NaN: none) and box
+    ``bounds`` (rows of x_min, y_min, x_max, y_max; metres). A query's x range is clipped to
+    [``low``, ``high``] and shifted by ``shift`` plus its strip's number times ``width`` (metres)."""
 
     tree: shapely.STRtree
     item: np.ndarray
+    everywhere: np.ndarray
     heading: np.ndarray
     bounds: np.ndarray
     low: float
@@ -57,47 +60,53 @@ class HeadingIndex:
     width: float
 
 
-def heading_index(headings: np.ndarray, bounds: np.ndarray) -> HeadingIndex:
+def heading_index(headings: np.ndarray, bounds: np.ndarray, everywhere: np.ndarray | None = None) -> HeadingIndex:
     """The index of items with headings ``headings[i]`` (a row of columns, 2-D; NaN: none) and
-    boxes ``bounds[i]`` (finite)."""
+    boxes ``bounds[i]`` (finite); items with ``everywhere[i]`` are found for every heading (their
+    headings unused), in one more strip."""
     bounds = np.asarray(bounds, dtype=float).reshape(-1, 4)
     headings = np.asarray(headings, dtype=float)
+    everywhere = np.zeros(len(bounds), dtype=bool) if everywhere is None else np.asarray(everywhere, dtype=bool)
     low = float(bounds[:, 0].min(initial=0.0))
     high = float(bounds[:, 2].max(initial=0.0))
     width = high - low + 2 * MARGIN_M
     shift = MARGIN_M - low
-    slack = SLACK_M + 64 * float(np.spacing(BINS * width + abs(shift)))
-    item, column = np.nonzero(~np.isnan(headings))
+    slack = SLACK_M + 64 * float(np.spacing((BINS + 1) * width + abs(shift)))
+    item, column = np.nonzero(~np.isnan(headings) & ~everywhere[:, None])
     angle = np.mod(headings[item, column], 2 * np.pi)
     item, first = _expand(item, _bin(angle - 2 * WINDOW_RAD), _bin(angle + 2 * WINDOW_RAD))
-    filed = np.unique(item.astype(np.int64) * BINS + np.mod(first, BINS))
-    item, offset = (filed // BINS).astype(np.intp), (filed % BINS) * width + shift
-    box = bounds[item]
+    filed = np.unique(item.astype(np.int64) * (BINS + 1) + np.mod(first, BINS))
+    filed = np.concatenate([filed, np.flatnonzero(everywhere) * (BINS + 1) + BINS])
+    item, strip = (filed // (BINS + 1)).astype(np.intp), filed % (BINS + 1)
+    offset, box = strip * width + shift, bounds[item]
     tree = shapely.STRtree(
         shapely.box(box[:, 0] + offset - slack, box[:, 1] - slack, box[:, 2] + offset + slack, box[:, 3] + slack)
     )
     half = MARGIN_M / 2
-    return HeadingIndex(tree, item, headings, bounds, low - half, high + half, shift, width)
+    return HeadingIndex(tree, item, strip == BINS, headings, bounds, low - half, high + half, shift, width)
 
 
 def near_heading(
     index: HeadingIndex, heading: np.ndarray, bounds: np.ndarray, window: float = WINDOW_RAD
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(query, item) pairs, each once: one of item's headings within ``window`` (radians, at most
-    :data:`WINDOW_RAD`) of ``heading[query]`` (radians, finite), modulo 2π (the turn from one to
-    the other wrapped to [-π, π), as ``(d + π) % 2π - π``), and its box meeting ``bounds[query]``
-    (rows of x_min, y_min, x_max, y_max; closed intervals)."""
+    """(query, item) pairs, each once: item's box meeting ``bounds[query]`` (rows of x_min, y_min,
+    x_max, y_max; closed intervals) and the item found for every heading or one of its headings
+    within ``window`` (radians, at most :data:`WINDOW_RAD`) of ``heading[query]`` (radians, finite),
+    modulo 2π (the turn from one to the other wrapped to [-π, π), as ``(d + π) % 2π - π``)."""
     bounds = np.asarray(bounds, dtype=float).reshape(-1, 4)
     heading = np.asarray(heading, dtype=float)
-    offset = np.mod(_bin(np.mod(heading, 2 * np.pi)), BINS) * index.width + index.shift
-    x = np.clip(bounds[:, 0::2], index.low, index.high) + offset[:, None]
+    n = len(bounds)
+    strip = np.mod(_bin(np.mod(heading, 2 * np.pi)), BINS)
+    if index.everywhere.any():
+        strip, bounds, heading = np.append(strip, np.full(n, BINS)), np.tile(bounds, (2, 1)), np.tile(heading, 2)
+    x = np.clip(bounds[:, 0::2], index.low, index.high) + (strip * index.width + index.shift)[:, None]
     query, entry = index.tree.query(shapely.box(x[:, 0], bounds[:, 1], x[:, 1], bounds[:, 3]))
     item = index.item[entry]
     mine, theirs = bounds[query], index.bounds[item]
     meet = np.all((mine[:, :2] <= theirs[:, 2:]) & (theirs[:, :2] <= mine[:, 2:]), axis=1)
     turn = np.abs(np.mod(index.heading[item] - heading[query][:, None] + np.pi, 2 * np.pi) - np.pi)
-    keep = np.flatnonzero(meet & np.any(turn <= window, axis=1))
-    return query[keep], item[keep]
+    keep = np.flatnonzero(meet & (index.everywhere[entry] | np.any(turn <= window, axis=1)))
+    return query[keep] % max(n, 1), item[keep]
 
 
 def _bin(angle: np.ndarray) -> np.ndarray:

@@ -2,27 +2,26 @@
  * scenegrep.readers.ros._place: the per-box math of framing (framing.py) in one C pass, so no
  * array is made per operation and each box is read and written once.
  *
- * place(xyz, quat, size, velocity, each, shift, turn, dest, out)
+ * place(xyz, quat, size, velocity, each, shift, turn, dest, out, cosine)
  *     For box i of n: position xyz[i] (n, 3), rotation quat[i] (n, 4; x, y, z, w), size[i]
  *     (n, 3) and velocity velocity[i] (n, 3), all float64 with any strides. each[i] (int64) is
  *     the row of its transform into the map frame in shift (m, 3) and turn (m, 4; a unit
  *     quaternion), or -1 when the box is in the map frame already. dest[i] (int64) is the row
- *     the box is written to in out, or -1 when it is not written. out is a sequence of 9
- *     float64 arrays (1-d, any stride, one length) that get, at row dest[i]: x, y, z (turn
- *     applied to xyz, then shift added), heading (the Scenic heading of the yaw of turn *
- *     quat), length, width, height (size as is), vx, vy (velocity turned by turn * quat). The
- *     formulas and their order of operations are those of transforms.py (product, rotated,
- *     yaw) and model.geometry.heading_from_yaw, so the results are theirs (atan2 may differ
- *     from numpy's in the last bit). Shapes, dtypes and every index of `each` and `dest` are
- *     checked before anything is written (ValueError otherwise).
+ *     the box is written to in out and cosine, or -1 when it is not written. out is a sequence
+ *     of 9 float64 arrays and cosine one more (1-d, any stride, all of one length); with
+ *     (x, y, z, w) = turn * quat, they get at row dest[i]: x, y, z (turn applied to xyz, then
+ *     shift added), 2 (w z + x y) in out[3] and 1 - 2 (y y + z z) in cosine (the yaw is their
+ *     atan2: the caller takes it with numpy's vectorised atan2, several times faster than a
+ *     call per box, and makes it the heading), length, width, height (size as is), vx, vy
+ *     (velocity turned by turn * quat). The formulas and their order of operations are those
+ *     of transforms.py (product, rotated, yaw), so the results are theirs bit for bit. Shapes,
+ *     dtypes and every index of `each` and `dest` are checked before anything is written
+ *     (ValueError otherwise).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #include <math.h>
 #include <stdint.h>
-
-#define PI 3.141592653589793
-#define TWO_PI (2.0 * PI)
 
 typedef struct {
     Py_buffer view;
@@ -58,27 +57,6 @@ static inline double at(const Array *a, Py_ssize_t i, Py_ssize_t j) {
     return *(const double *)((const char *)a->view.buf + i * a->view.strides[0] + j * a->view.strides[1]);
 }
 
-/* The Scenic heading of a yaw: normalize_angle(yaw - pi / 2) = pi - mod(pi - a, 2 pi), with
- * numpy's floating mod (the sign of the divisor). For a yaw of atan2 (in [-pi, pi]) the
- * argument lies in [pi / 2, 5 pi / 2], where that mod is one exact subtraction (Sterbenz), so
- * fmod runs only for other values. */
-static inline double heading_from_yaw(double yaw) {
-    double a = PI - (yaw - PI / 2), m;
-    if (a >= 0 && a < TWO_PI) {
-        m = a == 0 ? 0.0 : a;
-    } else if (a >= TWO_PI && a <= 2 * TWO_PI) {
-        m = a - TWO_PI;
-    } else {
-        m = fmod(a, TWO_PI);
-        if (m != 0) {
-            if (m < 0) m += TWO_PI;
-        } else {
-            m = 0.0;
-        }
-    }
-    return PI - m;
-}
-
 /* v rotated by the unit quaternion (ux, uy, uz, w): v + w t + u x t with t = 2 (u x v). */
 static inline void rotate(const double q[4], const double v[3], double r[3]) {
     double ux = q[0], uy = q[1], uz = q[2], w = q[3];
@@ -101,17 +79,17 @@ static inline void product(const double a[4], const double b[4], double r[4]) {
 
 static PyObject *place(PyObject *self, PyObject *args) {
     (void)self;
-    PyObject *objs[9];
-    if (!PyArg_ParseTuple(args, "OOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6],
-                          &objs[7], &objs[8]))
+    PyObject *objs[10];
+    if (!PyArg_ParseTuple(args, "OOOOOOOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4], &objs[5], &objs[6],
+                          &objs[7], &objs[8], &objs[9]))
         return NULL;
-    Array xyz, quat, size, velocity, each, shift, turn, dest, out[9];
-    Array *all[17] = {&xyz, &quat, &size, &velocity, &each, &shift, &turn, &dest};
-    for (int k = 0; k < 9; k++) all[8 + k] = &out[k];
-    for (int k = 0; k < 17; k++) all[k]->view.obj = NULL;
+    Array xyz, quat, size, velocity, each, shift, turn, dest, out[10];
+    Array *all[18] = {&xyz, &quat, &size, &velocity, &each, &shift, &turn, &dest};
+    for (int k = 0; k < 10; k++) all[8 + k] = &out[k];
+    for (int k = 0; k < 18; k++) all[k]->view.obj = NULL;
     PyObject *result = NULL, *columns = NULL;
-    static const char *names[9] = {"out x", "out y", "out z", "out heading", "out length", "out width", "out height",
-                                   "out vx", "out vy"};
+    static const char *names[10] = {"out x",     "out y",      "out z",  "out heading", "out length",
+                                    "out width", "out height", "out vx", "out vy",      "cosine"};
     if (get(objs[0], &xyz, "xyz", 2, 3, 0, 0) < 0 || get(objs[1], &quat, "quat", 2, 4, 0, 0) < 0 ||
         get(objs[2], &size, "size", 2, 3, 0, 0) < 0 || get(objs[3], &velocity, "velocity", 2, 3, 0, 0) < 0 ||
         get(objs[4], &each, "each", 1, 0, 0, 1) < 0 || get(objs[5], &shift, "shift", 2, 3, 0, 0) < 0 ||
@@ -125,9 +103,10 @@ static PyObject *place(PyObject *self, PyObject *args) {
     }
     for (int k = 0; k < 9; k++)
         if (get(PySequence_Fast_GET_ITEM(columns, k), &out[k], names[k], 1, 0, 1, 0) < 0) goto done;
+    if (get(objs[9], &out[9], names[9], 1, 0, 1, 0) < 0) goto done;
     Py_ssize_t n = xyz.view.shape[0], m = shift.view.shape[0], rows = out[0].view.shape[0];
     int same = 1;
-    for (int k = 1; k < 9; k++) same &= out[k].view.shape[0] == rows;
+    for (int k = 1; k < 10; k++) same &= out[k].view.shape[0] == rows;
     if (quat.view.shape[0] != n || size.view.shape[0] != n || velocity.view.shape[0] != n ||
         each.view.shape[0] != n || dest.view.shape[0] != n || turn.view.shape[0] != m || !same) {
         PyErr_SetString(PyExc_ValueError, "place: arrays of different lengths");
@@ -146,9 +125,9 @@ static PyObject *place(PyObject *self, PyObject *args) {
             goto done;
         }
     }
-    char *o[9];
-    Py_ssize_t os[9];
-    for (int k = 0; k < 9; k++) {
+    char *o[10];
+    Py_ssize_t os[10];
+    for (int k = 0; k < 10; k++) {
         o[k] = out[k].view.buf;
         os[k] = out[k].view.strides[0];
     }
@@ -172,9 +151,9 @@ static PyObject *place(PyObject *self, PyObject *args) {
         double x = rotation[0], y = rotation[1], z = rotation[2], w = rotation[3];
         double sine = (w * z + x * y) * 2.0, cosine = (y * y + z * z) * 2.0;
         rotate(rotation, v, moved);
-        double values[9] = {position[0], position[1], position[2], heading_from_yaw(atan2(sine, 1.0 - cosine)),
-                            at(&size, i, 0), at(&size, i, 1), at(&size, i, 2), moved[0], moved[1]};
-        for (int k = 0; k < 9; k++) *(double *)(o[k] + d * os[k]) = values[k];
+        double values[10] = {position[0],     position[1],     position[2], sine,     at(&size, i, 0),
+                             at(&size, i, 1), at(&size, i, 2), moved[0],    moved[1], 1.0 - cosine};
+        for (int k = 0; k < 10; k++) *(double *)(o[k] + d * os[k]) = values[k];
     }
     Py_END_ALLOW_THREADS
     result = Py_NewRef(Py_None);
@@ -186,7 +165,7 @@ done:
 }
 
 static PyMethodDef methods[] = {
-    {"place", place, METH_VARARGS, "place(xyz, quat, size, velocity, each, shift, turn, dest, out): see the module comment"},
+    {"place", place, METH_VARARGS, "place(xyz, quat, size, velocity, each, shift, turn, dest, out, cosine): see the module comment"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -431,15 +431,18 @@ class FrameBuilder:
         frame_all, ids_all = (np.concatenate(c) if c else np.empty(0, np.int32) for c in (frame, ids))
         dest, kept_frames, kept_numbers = self._placement(frame_all, ids_all, classes, objects, out)
         start, stop = out.size, out.size + len(kept_frames)
-        columns = [c.rows(start, stop) for c in out.values]
+        columns, cosine = [c.rows(start, stop) for c in out.values], np.empty(stop - start)
         offset = 0
         for (seg, rows), rows_frame in zip(taken, frame):  # (the boxes first: their errors come first)
-            self._values(seg, rows, dest[offset : offset + len(rows_frame)], columns)
+            self._values(seg, rows, dest[offset : offset + len(rows_frame)], columns, cosine)
             offset += len(rows_frame)
+        at = dest[offset:][dest[offset:] >= 0]  # (the ego's rows)
+        heading = columns[FLOAT_COLUMNS.index("heading")]
+        heading[at], cosine[at] = 0.0, 1.0
+        heading[:] = heading_from_yaw(np.arctan2(heading, cosine, out=heading))
         if has_ego:
-            ego, at = self._ego(stamps), dest[offset:]
-            for column, values in zip(columns, ego):
-                column[at[at >= 0]] = values[at >= 0]
+            for column, values in zip(columns, self._ego(stamps)):
+                column[at] = values[dest[offset:] >= 0]
         np.add(kept_frames, out.frames, out=out.frame.rows(start, stop))
         out.object.rows(start, stop)[:] = kept_numbers
         out.size = stop
@@ -497,12 +500,15 @@ class FrameBuilder:
         present = first < len(ids)
         return candidates[present], first[present]
 
-    def _values(self, seg: _Segment, rows: np.ndarray | slice, dest: np.ndarray, columns: list[np.ndarray]) -> None:
+    def _values(
+        self, seg: _Segment, rows: np.ndarray | slice, dest: np.ndarray, columns: list[np.ndarray], cosine: np.ndarray
+    ) -> None:
         """Write the state values of ``rows`` of a segment's boxes into the state ``columns``
         (:data:`~scenegrep.model.states.FLOAT_COLUMNS`) at rows ``dest`` (-1: not written):
         each box moved into the map frame with the transform of its frame id at its stamp, its
-        heading the yaw of its rotation there, its velocity turned by that rotation (one pass of
-        :func:`._place.place` over the boxes, with one transform per frame id and stamp)."""
+        velocity turned by its rotation there (one pass of :func:`._place.place` over the boxes,
+        with one transform per frame id and stamp); in place of the heading, the sine term of
+        the rotation's yaw, its cosine term in ``cosine`` (the caller takes their atan2)."""
         boxes: Boxes = seg.boxes  # type: ignore[assignment]
         codes = seg.frames[rows]  # type: ignore[index]
         present = np.flatnonzero(np.bincount(codes, minlength=1)).tolist()
@@ -520,7 +526,7 @@ class FrameBuilder:
         shift = np.concatenate(shifts) if len(shifts) > 1 else shifts[0] if shifts else np.empty((0, 3))
         turn = np.concatenate(turns) if len(turns) > 1 else turns[0] if turns else np.empty((0, 4))
         xyz, quat, size, velocity = boxes.xyz[rows], boxes.quat[rows], boxes.size[rows], boxes.velocity[rows]
-        place(xyz, quat, size, velocity, each, shift, turn, dest, columns)
+        place(xyz, quat, size, velocity, each, shift, turn, dest, columns, cosine)
 
     def _transforms(
         self, seg: _Segment, rows: np.ndarray | slice, group: np.ndarray | slice, code: int

@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 from scenegrep.model.geometry import (
     box_corners,
     heading_difference,
+    heading_from_atan2,
     heading_from_yaw,
     heading_of_vector,
     normalize_angle,
@@ -24,6 +25,16 @@ def test_heading_of_segment_matches_scenic_example():
     # docs/scenic-reference.md: headingOfSegment((0,0),(3,4)) = -0.6435
     assert math.isclose(float(heading_of_vector(3, 4)), math.atan2(-3, 4), abs_tol=1e-12)
     assert round(float(heading_of_vector(3, 4)), 4) == -0.6435
+
+
+def test_heading_from_atan2_is_heading_from_yaw_bit_for_bit():
+    rng = np.random.default_rng(7)
+    edges = [-math.pi, math.pi, -0.0, 0.0, -math.pi / 2, math.pi / 2, 3 * math.pi / 4, -3 * math.pi / 4, math.nan]
+    edges += [np.nextafter(e, d) for e in edges[:-1] for d in (-4.0, 4.0) if -math.pi <= np.nextafter(e, d) <= math.pi]
+    yaws = np.concatenate([edges, np.arctan2(rng.normal(size=200_000), rng.normal(size=200_000))])
+    expected = heading_from_yaw(yaws)
+    got = heading_from_atan2(yaws.copy())
+    np.testing.assert_array_equal(got.view(np.int64), expected.view(np.int64))  # (bits: signs of zero too)
 
 
 def test_cardinal_directions():

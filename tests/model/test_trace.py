@@ -8,6 +8,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from scenegrep.model import BehaviourLabels, LabelTrace, ObjectTable, StateTable
+from scenegrep.model import states as states_module
+from scenegrep.model import trace as trace_module
 from tests.strategies import label_traces
 
 
@@ -40,8 +42,8 @@ def test_validate_rejects_duplicates_and_bad_codes():
 def test_build_checks_the_row_order_once_and_still_refuses_bad_rows(monkeypatch):
     objects = ObjectTable.build(["a", "b"], ["car", "car"])
     calls = []
-    row_keys = StateTable.row_keys
-    monkeypatch.setattr(StateTable, "row_keys", lambda self, n: calls.append(n) or row_keys(self, n))
+    in_order = StateTable.in_order
+    monkeypatch.setattr(StateTable, "in_order", lambda self, n: calls.append(n) or in_order(self, n))
     LabelTrace.build(
         "t", [0, 1], [0.0, 0.1], objects, StateTable.build([0, 0, 1], [0, 1, 1], [0] * 3, [0] * 3, [0] * 3)
     )
@@ -58,6 +60,38 @@ def test_build_checks_the_row_order_once_and_still_refuses_bad_rows(monkeypatch)
         LabelTrace.build("t", [0], [0.0], objects, StateTable.build([0, 0], [-1, 0], [0] * 2, [0] * 2, [0] * 2))
     with pytest.raises(ValueError, match="object out of range"):
         LabelTrace.build("t", [0], [0.0], objects, StateTable.build([0, 0], [0, 2], [0] * 2, [0] * 2, [0] * 2))
+
+
+@pytest.mark.parametrize("at", [1, 2, 3, 4, 5])
+def test_row_order_and_values_are_checked_across_blocks(monkeypatch, at):
+    monkeypatch.setattr(states_module, "BLOCK", 2)
+    monkeypatch.setattr(trace_module, "BLOCK", 2)
+    objects = ObjectTable.build(["a", "b"], ["car", "car"])
+    frames, ids = [0, 0, 1, 1, 2, 2, 3], [0, 1, 0, 1, 0, 1, 0]
+    assert StateTable.build(frames, ids, [0] * 7, [0] * 7, [0] * 7).in_order(2)
+    frames[at], frames[at - 1] = frames[at - 1], frames[at]  # (swapped across or inside a block)
+    ids[at], ids[at - 1] = ids[at - 1], ids[at]
+    assert not StateTable.build(frames, ids, [0] * 7, [0] * 7, [0] * 7).in_order(2)
+    x = [0.0] * 7
+    x[at] = np.inf
+    with pytest.raises(ValueError, match="x is inf"):
+        LabelTrace.build(
+            "t",
+            range(4),
+            np.arange(4.0),
+            objects,
+            StateTable.build([0, 0, 1, 1, 2, 2, 3], [0, 1, 0, 1, 0, 1, 0], x, [0] * 7, [0] * 7),
+        )
+    length = [1.0] * 7
+    length[at] = -1.0
+    with pytest.raises(ValueError, match="length is -1.0"):
+        LabelTrace.build(
+            "t",
+            range(4),
+            np.arange(4.0),
+            objects,
+            StateTable.build([0, 0, 1, 1, 2, 2, 3], [0, 1, 0, 1, 0, 1, 0], [0] * 7, [0] * 7, [0] * 7, length=length),
+        )
 
 
 def test_dense_and_present():

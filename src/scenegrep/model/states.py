@@ -18,6 +18,9 @@ from .table import RowTable, float_column, int_column
 FLOAT_COLUMNS = ("x", "y", "z", "heading", "length", "width", "height", "vx", "vy")
 """The float64 columns of a :class:`StateTable`, in storage order."""
 
+BLOCK = 1 << 18
+"""Rows checked at a time by whole-table checks (their scratch arrays stay small and warm)."""
+
 
 @dataclass(frozen=True, eq=False)
 class StateTable(RowTable):
@@ -62,10 +65,22 @@ class StateTable(RowTable):
 
     def sort_order(self) -> np.ndarray | None:
         """The permutation that orders rows by (frame, object), or None when already ordered."""
-        key = self.row_keys(int(self.object.max(initial=0)) + 1)
-        if len(key) < 2 or bool(np.all(key[1:] > key[:-1])):
-            return None
-        return np.argsort(key, kind="stable")
+        objects = int(self.object.max(initial=0)) + 1
+        return None if self.in_order(objects) else np.argsort(self.row_keys(objects), kind="stable")
+
+    def in_order(self, objects: int) -> bool:
+        """Whether the rows are in (frame, object) order without repeats (``objects`` above every
+        object code): :meth:`row_keys` strictly increasing, checked in blocks of :data:`BLOCK`
+        rows (no array of the table's length is made)."""
+        n = len(self.frame)
+        for start in range(0, n - 1, BLOCK):
+            stop = min(start + BLOCK + 1, n)  # (one row of overlap with the next block)
+            key = self.frame[start:stop].astype(np.int64)
+            key *= objects
+            key += self.object[start:stop]
+            if not (key[1:] > key[:-1]).all():
+                return False
+        return True
 
     def row_keys(self, objects: int) -> np.ndarray:
         """``frame * objects + object`` of every row as int64 (increasing along the rows exactly when

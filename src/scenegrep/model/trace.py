@@ -20,7 +20,7 @@ import numpy as np
 from .behaviours import BehaviourLabels
 from .images import ImageLayer, concatenate_layers
 from .objects import ObjectTable
-from .states import StateTable
+from .states import BLOCK, StateTable
 
 
 EGO_SIZE_UNKNOWN = "ego_size_unknown"
@@ -137,8 +137,7 @@ class LabelTrace:
             raise ValueError("state object out of range")
         if len(s) and (s.lane.min() < -1 or s.lane.max() >= len(self.lane_ids)):
             raise ValueError("state lane code out of range")
-        key = None if ordered else s.row_keys(max(self.n_objects, 1))
-        if key is not None and np.any(key[1:] <= key[:-1]):
+        if not ordered and not s.in_order(max(self.n_objects, 1)):
             raise ValueError("states must be sorted by (frame, object) without duplicates")
         if self.behaviours is not None and len(self.behaviours) != len(s):
             raise ValueError("behaviour labels must align with state rows")
@@ -173,13 +172,15 @@ class LabelTrace:
         s = self.states
         for name in ("x", "y", "heading", "z", "length", "width", "height", "vx", "vy"):
             values = getattr(s, name)
-            required = name in ("x", "y", "heading")
-            bad = ~np.isfinite(values) if required else np.isinf(values)
-            if name in ("length", "width", "height"):
-                bad |= values < 0
-            if bad.any():
-                row = int(np.argmax(bad))
-                raise ValueError(f"{self._state_name(row)}: {name} is {float(values[row])!r} (must be {_RULES[name]})")
+            for start in range(0, len(values), BLOCK):  # (in blocks: small scratch arrays)
+                block = values[start : start + BLOCK]
+                bad = ~np.isfinite(block) if name in ("x", "y", "heading") else np.isinf(block)
+                if name in ("length", "width", "height"):
+                    bad |= block < 0
+                if bad.any():
+                    row = start + int(np.argmax(bad))
+                    rule = _RULES[name]
+                    raise ValueError(f"{self._state_name(row)}: {name} is {float(values[row])!r} (must be {rule})")
 
     def _frame_name(self, position: int) -> str:
         return f"{position} (index {self.frame_index[position]})"

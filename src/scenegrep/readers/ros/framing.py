@@ -50,7 +50,7 @@ import numpy as np
 
 from ...errors import UserError
 from ...model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
-from ...model.geometry import heading_from_yaw
+from ...model.geometry import heading_from_atan2, heading_from_yaw
 from ...model.images import concatenate_layers
 from ...model.states import FLOAT_COLUMNS
 from ...model.trace import EGO_SIZE_UNKNOWN
@@ -439,7 +439,7 @@ class FrameBuilder:
         at = dest[offset:][dest[offset:] >= 0]  # (the ego's rows)
         heading = columns[FLOAT_COLUMNS.index("heading")]
         heading[at], cosine[at] = 0.0, 1.0
-        heading[:] = heading_from_yaw(np.arctan2(heading, cosine, out=heading))
+        heading_from_atan2(np.arctan2(heading, cosine, out=heading))
         if has_ego:
             for column, values in zip(columns, self._ego(stamps)):
                 column[at] = values[dest[offset:] >= 0]

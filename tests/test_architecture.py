@@ -55,6 +55,7 @@ SCENE_LAYERS: tuple[tuple[str, ...], ...] = (
         "follow_inverse",
         "heading_index",
         "clip",
+        "_reach",
     ),  # map geometry
     ("context", "expressions", "specifiers", "lenient_boxes", "resolve", "needs"),  # syntax, specifier semantics
     ("dependencies", "randoms", "evaluate"),  # analysis and evaluation

@@ -1,5 +1,5 @@
 """The inverted walk's narrowing of a candidate segment's D interval to where its centreline's
-nearest point may lie on it (:func:`scenegrep.scene.follow_inverse._nearest_on`) never drops a
+nearest point may lie on it (:func:`scenegrep.scene.follow_inverse._narrowed`) never drops a
 point the projection (:meth:`scenegrep.model.polylines.Polylines.segment_at`, the rule Scenic's
 headings are read with) gives to that segment: on random points near Town01's lane and shoulder
 centrelines, ties at vertices included; and the preimages of random Town01 walk ends equal those
@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from scenegrep.scene import follow_inverse
-from scenegrep.scene.follow_inverse import _nearest_on, inverse, preimages
+from scenegrep.scene.follow_inverse import _narrowed, inverse, preimages
 from tests.scene.test_follow import FIELD
 from tests.scene.test_follow_start import town01, town01_walks
 
@@ -47,10 +47,8 @@ def test_the_segment_the_projection_picks_is_never_narrowed_away(seed, dx, dy, s
     t = rng.uniform(0.0, 1.0, len(points))
     r = rng.normal(0, 4.0, (len(points), 2))
     p = points - t[:, None] * r
-    ends = (inv.ends[picked, :2], inv.ends[picked, 2:])
-    low, high = _nearest_on(
-        p, r, ends, inv.unit[picked], (inv.before[picked], inv.after[picked]), (np.zeros(len(p)), np.ones(len(p)))
-    )
+    a, z, anywhere = inv.ends[picked, :2], inv.ends[picked, 2:], np.full(len(p), np.inf)
+    low, high = _narrowed(p, r, a, z, anywhere, inv.unit[picked], inv.before[picked], inv.after[picked])
     assert np.all((low <= t) & (t <= high)), points[~((low <= t) & (t <= high))]
 
 
@@ -64,7 +62,7 @@ def test_town01_preimages_equal_those_without_the_narrowing(monkeypatch):
     distance are in it."""
     geometry, x, y, distance, ex, ey, lo, hi = town01_walks(16, 2000, 60)
     narrowed = [preimages(geometry, FIELD, ex, ey, lo, hi, check) for check in (True, False)]
-    monkeypatch.setattr(follow_inverse, "_nearest_on", lambda p, r, ends, unit, neighbours, span: span)
+    monkeypatch.setattr(follow_inverse, "_narrowed", lambda *rows: _narrowed(*rows, nearest=False))
     whole = [rows(preimages(geometry, FIELD, ex, ey, lo, hi, check)) for check in (True, False)]
     checked = rows(narrowed[0])
     wide = [table[table[:, 6] > table[:, 5] + 1e-9] for table in (checked, whole[0])]

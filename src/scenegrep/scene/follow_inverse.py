@@ -73,6 +73,7 @@ import numpy as np
 import shapely
 
 from ..model.polylines import Polylines
+from ._reach import narrow
 from .clip import clipped
 from .follow_pieces import DEGENERATE_M, _by_step_count, _Columns, _split, linework
 from .geometry import ELEMENT_REACH_M, MapGeometry
@@ -394,8 +395,7 @@ def _candidates(inv: Inverse, ex, ey, b: _Back, held: np.ndarray) -> _Moved:
     ay = np.concatenate([b.ay[near] + inv.step[segment, 1] / steps, b.ay + -1.0 / b.steps])
     branch = np.concatenate([near, np.arange(len(b.row))])
     heading = np.concatenate([inv.heading[segment], np.zeros(len(b.row))])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lo, hi = _within(inv, x[branch], y[branch], b.lo[branch], b.hi[branch], ax, ay, segment, held[near])
+    lo, hi = _within(inv, x[branch], y[branch], b.lo[branch], b.hi[branch], ax, ay, segment, held[near])
     keep = np.flatnonzero(lo <= hi)
     order = keep[np.lexsort((heading[keep], branch[keep]))]
     branch, heading = branch[order], heading[order]
@@ -414,12 +414,11 @@ def _candidates(inv: Inverse, ex, ey, b: _Back, held: np.ndarray) -> _Moved:
 def _within(inv: Inverse, x, y, lo, hi, ax, ay, segment, held) -> tuple[np.ndarray, np.ndarray]:
     """The D interval (lo > hi: none) on which the point ``(x, y) + D (ax, ay)`` (row i, D in
     [lo[i], hi[i]]) comes within its reach of the segment ``segment[i]`` of ``inv`` where its
-    centreline's nearest point may lie on that segment (:func:`_nearest_on`), as the hull of that
+    centreline's nearest point may lie on that segment (:func:`_narrowed`), as the hull of that
     set, dropped where ``held[i]`` and that part of the swept segment misses the centreline's
     holding region; for the rows past ``segment`` (heading 0), where it may leave the roads. Rows whose
     swept segment misses the box within the segment's reach are dropped before the exact test
-    (most of them: the R-tree's query box is a whole step wide in every direction). Call with
-    numpy's divide and invalid warnings off."""
+    (most of them: the R-tree's query box is a whole step wide in every direction)."""
     px, qx = x + lo * ax, x + hi * ax
     py, qy = y + lo * ay, y + hi * ay
     n = len(segment)
@@ -438,9 +437,7 @@ def _within(inv: Inverse, x, y, lo, hi, ax, ay, segment, held) -> tuple[np.ndarr
     r = np.stack([qx[meet], qy[meet]], axis=1) - p
     s = segment[meet]
     a, z = inv.ends[s, :2], inv.ends[s, 2:]
-    t_lo, t_hi = _nearest_on(
-        p, r, (a, z), inv.unit[s], (inv.before[s], inv.after[s]), _stadium(p, r, a, z, inv.reach[s])
-    )
+    t_lo, t_hi = _narrowed(p, r, a, z, inv.reach[s], inv.unit[s], inv.before[s], inv.after[s])
     hit = meet[t_lo <= t_hi]  # elsewhere t_hi may be -inf, and -inf * 0 (a point interval) is NaN
     t_lo, t_hi = t_lo[t_lo <= t_hi], t_hi[t_lo <= t_hi]
     width = hi[hit] - lo[hit]
@@ -453,81 +450,26 @@ def _within(inv: Inverse, x, y, lo, hi, ax, ay, segment, held) -> tuple[np.ndarr
     return start, end
 
 
-def _nearest_on(p, r, ends, unit, neighbours, span) -> tuple[np.ndarray, np.ndarray]:
-    """``span`` ([t_lo, t_hi] per row) narrowed to the hull of the t at which the nearest point of
-    its centreline to p + t r may lie on the segment ``ends`` (its start rows, its end rows;
-    ``unit``: its direction): dropped are the t at which the point lies :data:`FOOT_SLACK_M` or
-    more before the start along it and along the segment before (``neighbours[0]``: its direction;
-    NaN: none), whose end is then nearer, and likewise past the end along it and the segment after
-    (``neighbours[1]``). Call with numpy's divide and invalid warnings off."""
-    low, high = span
-    vertex = np.stack([ends[0], ends[0], ends[1], ends[1]])
-    direction = np.stack([unit, neighbours[0], unit, neighbours[1]])
-    sign = np.array([[-1.0], [-1.0], [1.0], [1.0]])
-    along = sign * np.einsum("kij,kij->ki", p - vertex, direction)
-    rate = sign * np.einsum("ij,kij->ki", r, direction)
-    f_lo, f_hi = _linear_bounds(along, rate, FOOT_SLACK_M, np.inf)
-    f_lo = np.maximum(np.maximum(0.0, f_lo[0::2]), f_lo[1::2])
-    f_hi = np.minimum(np.minimum(1.0, f_hi[0::2]), f_hi[1::2])
-    none = np.isnan(f_lo) | np.isnan(f_hi) | np.isnan(direction[1::2, :, 0])
-    f_lo, f_hi = np.where(none, np.inf, f_lo), np.where(none, -np.inf, f_hi)
-    for _ in range(2):
-        for k in range(2):
-            low = np.where((low >= f_lo[k]) & (low <= f_hi[k]), f_hi[k], low)
-            high = np.where((high >= f_lo[k]) & (high <= f_hi[k]), f_lo[k], high)
-    return low, high
-
-
-def _stadium(p, r, a, b, radius) -> tuple[np.ndarray, np.ndarray]:
+def _narrowed(p, r, a, z, radius, unit, before, after, nearest: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """The hull [t_lo, t_hi] (t_lo > t_hi: empty) of the t in [0, 1] at which p + t r lies within
-    ``radius`` of the segment a-b: the union of the band along it and the discs at its ends. Call
-    with numpy's divide and invalid warnings off."""
-    w = b - a
-    ww = np.einsum("ij,ij->i", w, w)
-    length = np.sqrt(ww)
-    pa = p - a
-    f0 = np.stack([np.einsum("ij,ij->i", pa, w) / ww, _cross(w, pa) / length])
-    f1 = np.stack([np.einsum("ij,ij->i", r, w) / ww, _cross(w, r) / length])
-    zero = np.zeros(len(p))
-    low, high = _linear_bounds(f0, f1, np.stack([zero, -radius]), np.stack([zero + 1.0, radius]))
-    band = ww > 0
-    low = np.where(band, np.maximum(np.maximum(0.0, low[0]), low[1]), np.inf)
-    high = np.where(band, np.minimum(np.minimum(1.0, high[0]), high[1]), -np.inf)
-    disc_lo, disc_hi = _quadratic_below(r, np.stack([pa, p - b]), radius)
-    lows, highs = np.concatenate([disc_lo, low[None]]), np.concatenate([disc_hi, high[None]])
-    empty = lows > highs
-    return np.where(empty, np.inf, lows).min(axis=0), np.where(empty, -np.inf, highs).max(axis=0)
-
-
-def _quadratic_below(r, d, radius) -> tuple[np.ndarray, np.ndarray]:
-    """The t in [0, 1] with |d[k] + t r| <= radius (``d``: a stack of row sets, each like ``r``),
-    as intervals (low > high: none; an empty one may be infinite). Call with numpy's divide and
-    invalid warnings off."""
-    rr = np.einsum("ij,ij->i", r, r)
-    dr = np.einsum("kij,ij->ki", d, r)
-    c = np.einsum("kij,kij->ki", d, d) - radius * radius
-    moving = rr > DEGENERATE_M**2
-    disc = dr * dr - rr * c
-    root = np.sqrt(np.where(disc >= 0, disc, np.nan))
-    low = np.where(moving, (-dr - root) / rr, np.where(c <= 0, 0.0, np.inf))
-    high = np.where(moving, (-dr + root) / rr, np.where(c <= 0, 1.0, -np.inf))
-    none = np.isnan(low) | np.isnan(high)
-    return np.where(none, np.inf, np.maximum(low, 0.0)), np.where(none, -np.inf, np.minimum(high, 1.0))
-
-
-def _linear_bounds(f0, f1, bottom, top) -> tuple[np.ndarray, np.ndarray]:
-    """The t where bottom <= f0 + f1 t <= top, as intervals (low > high: none; -inf, inf: every
-    t), to be intersected with the others by maximum and minimum (NaN where f0 or f1 is)."""
-    u, v = (bottom - f0) / f1, (top - f0) / f1
-    flat = np.abs(f1) <= 1e-300
-    inside = (f0 >= bottom) & (f0 <= top)
-    low = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(u, v))
-    high = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(u, v))
+    ``radius`` of the segment a-z (the union of the band along it and the discs at its ends: an
+    infinite radius gives [0, 1]); with ``nearest``, narrowed to the hull of the t at which the
+    nearest point of its centreline may lie on that segment (``unit``: its direction): dropped
+    are the t at which the point lies :data:`FOOT_SLACK_M` or more before a along it and along
+    the segment before (``before``: its direction; NaN: none), whose end is then nearer, and
+    likewise past z along it and the segment after (``after``): each end's forbidden interval
+    is where both hold (two linear bounds), and the hull's ends are moved past them twice.
+    Rows are numpy float64 arrays (points and directions (m, 2), ``radius`` (m,)); one C pass
+    (:mod:`._reach`; its numpy formulas, bit for bit)."""
+    low, high = np.empty(len(p)), np.empty(len(p))
+    rows = (p, r, a, z, radius, unit, before, after)
+    narrow(*(np.ascontiguousarray(v, dtype=float) for v in rows), _CONSTANTS, nearest, low, high)
     return low, high
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+_CONSTANTS = (DEGENERATE_M**2, FOOT_SLACK_M)
+"""What :func:`_narrowed`'s C pass takes as given: a swept segment whose squared length is at most
+the first does not move; the foot slack (metres)."""
 
 
 def _consistent(geometry: MapGeometry, field: Field, lw, ex, ey, moved: _Moved) -> _Moved:

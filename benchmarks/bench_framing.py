@@ -2,11 +2,10 @@
 fed pre-decoded batches, in CPU microseconds per TrackedObjects message.
 
 The bag of ``bench_bag.py --read N`` (N TrackedObjects messages of ``--objects`` objects, one
-``/tf`` message per frame) is read and decoded once, in the offline reader's batches; the
-decoded boxes and links are kept (the messages' bytes are not). Then, ``--runs`` times, a
-:class:`FrameBuilder` is fed the same batches with decoding replaced by a look-up of the kept
-results, into one trace as ``read_trace`` makes it; the CPU time (``time.process_time``) of
-that is the framing time. ``--lifetime L`` gives each object a new
+``/tf`` message per frame) is read and decoded once, in the offline reader's batches of segments
+(:func:`~scenegrep.readers.ros.segments.decoded_batches`); they are kept. Then, ``--runs`` times,
+a :class:`FrameBuilder` is fed the same batches into one trace as ``read_trace`` makes it; the
+CPU time (``time.process_time``) of that is the framing time. ``--lifetime L`` gives each object a new
 UUID every L messages (staggered), so the trace has about N * objects / L objects, as a real
 log's tracks come and go (default: the same objects throughout, as bench_bag.py writes).
 ``--coded``: the boxes' ids, classes and frame ids come as :class:`Coded` columns (codes into
@@ -38,10 +37,10 @@ sys.path.insert(0, str(REPO / "benchmarks"))
 
 from bench_bag import write_read_bench  # noqa: E402
 from scenegrep.readers.ros import decoders, framing  # noqa: E402
-from scenegrep.readers.ros.bag import bag_messages  # noqa: E402
-from scenegrep.readers.ros.messages import Boxes, Coded, RawMessage  # noqa: E402
+from scenegrep.readers.ros.bag import bag_runs  # noqa: E402
+from scenegrep.readers.ros.messages import Boxes, Coded  # noqa: E402
 from scenegrep.readers.ros.options import BagOptions  # noqa: E402
-from scenegrep.readers.ros.reader import batches  # noqa: E402
+from scenegrep.readers.ros.segments import Segment, decoded_batches  # noqa: E402
 
 
 def churned(boxes: Boxes, lifetime: int, start: int) -> Boxes:
@@ -57,34 +56,30 @@ def churned(boxes: Boxes, lifetime: int, start: int) -> Boxes:
     return dataclasses.replace(boxes, id=decoders._uuid_text(raw))
 
 
-def predecode(path: Path, lifetime: int, coded: bool) -> tuple[list[list[RawMessage]], dict]:
-    """The batches (messages without their bytes) and each topic batch's decoded result, keyed by
-    (topic, first log time); ``coded``: the boxes' string columns as :class:`Coded`."""
-    light, cache, start = [], {}, 0
-    for batch in batches(bag_messages(path, views=True)):
-        by_topic: dict[str, list[RawMessage]] = {}
-        for m in batch:
-            by_topic.setdefault(m.topic, []).append(m)
-        for topic, messages in by_topic.items():
-            decoded = decoders.decode_batch(messages)
+def predecode(path: Path, lifetime: int, coded: bool) -> list[list[Segment]]:
+    """The batches of segments of the bag; ``coded``: the boxes' string columns as :class:`Coded`."""
+    out, start = [], 0
+    for batch in decoded_batches(bag_runs(path, views=True), BagOptions()):
+        kept = []
+        for segment in batch:
+            decoded = segment.decoded
             if lifetime and isinstance(decoded, Boxes):
                 decoded = churned(decoded, lifetime, start)
-                start += len(messages)
+                start += len(segment.log_times)
             if coded and isinstance(decoded, Boxes):
                 columns = {c: getattr(decoded, c) for c in ("id", "category", "frame_id")}
                 decoded = dataclasses.replace(
                     decoded, **{c: v if isinstance(v, Coded) else Coded.of(v) for c, v in columns.items()}
                 )
-            cache[topic, messages[0].log_time] = decoded
-        light.append([m._replace(data=b"") for m in batch])
-    return light, cache
+            kept.append(dataclasses.replace(segment, decoded=decoded))
+        out.append(kept)
+    return out
 
 
-def run(light: list[list[RawMessage]], cache: dict) -> tuple[float, object]:
-    """CPU seconds of framing the batches (decoding looked up) into one trace."""
-    framing.decode_batch = lambda messages: cache[messages[0].topic, messages[0].log_time]
+def run(batches: list[list[Segment]]) -> tuple[float, object]:
+    """CPU seconds of framing the batches into one trace."""
     start = time.process_time()
-    trace = framing.frames(light, BagOptions(), "bench")
+    trace = framing.frames(batches, BagOptions(), "bench")
     return time.process_time() - start, trace
 
 
@@ -101,10 +96,10 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "bench.mcap"
         write_read_bench(path, args.read, args.objects)
-        light, cache = predecode(path, args.lifetime, args.coded)
+        batches = predecode(path, args.lifetime, args.coded)
     times = []
     for _ in range(args.runs):
-        seconds, trace = run(light, cache)
+        seconds, trace = run(batches)
         times.append(seconds / args.read * 1e6)
     assert trace.n_frames == args.read, trace.n_frames
     report = {
@@ -121,7 +116,7 @@ def main() -> None:
     print(json.dumps(report, indent=2))
     if args.profile:
         profile = cProfile.Profile()
-        profile.runcall(run, light, cache)
+        profile.runcall(run, batches)
         pstats.Stats(profile).sort_stats(args.sort).print_stats(35)
 
 

@@ -19,6 +19,7 @@ from scenegrep.readers.ros import framing
 from scenegrep.readers.ros.framing import FrameBuilder
 from scenegrep.readers.ros.messages import Boxes, Coded, RawMessage, Transforms
 from scenegrep.readers.ros.options import BagOptions
+from scenegrep.readers.ros.segments import Segment
 
 ORIGIN = 1_700_000_000_000_000_000
 STEP = 100_000_000
@@ -88,13 +89,24 @@ def _batches(n_frames: int, cuts: list[int]) -> list[list[RawMessage]]:
     return [messages[a:b] for a, b in zip(bounds, bounds[1:])]
 
 
+def _segments(batch: list[RawMessage], frames: list, coded: bool) -> list[Segment]:
+    """A batch's segments as the decoding stage gives them (topics in order of first appearance)."""
+    by_topic: dict[str, list[RawMessage]] = {}
+    for m in batch:
+        by_topic.setdefault(m.topic, []).append(m)
+    return [
+        Segment(t, SCHEMAS[t], "cdr", np.array([m.log_time for m in ms]), _decoded(ms, frames, coded))
+        for t, ms in by_topic.items()
+    ]
+
+
 def _run(frames: list, cuts: list[int], coded: bool, online: bool):
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(framing, "decode_batch", lambda messages: _decoded(messages, frames, coded))
+        patch.setattr(framing, "segments", lambda batch, options: _segments(batch, frames, coded))
         builder = FrameBuilder(BagOptions(), "random")
         batches = _batches(len(frames), cuts)
         if not online:
-            return builder.run(batches)
+            return builder.run([_segments(b, frames, coded) for b in batches])
         chunks = [c for batch in batches if (c := builder.feed(batch)) is not None]
         last = builder.finish()
         return concatenate(chunks + ([last] if last is not None else []))

@@ -131,12 +131,18 @@ class Records:
     def messages(self, offset: int, opcode: int, body: memoryview) -> Iterator[RawMessage]:
         """The messages of the record at byte ``offset`` (a Message, or a Chunk's, in order),
         registering the schemas and channels it defines; other records give none."""
+        for run in self.runs(offset, opcode, body):
+            yield from run
+
+    def runs(self, offset: int, opcode: int, body: memoryview) -> Iterator[list[RawMessage]]:
+        """The messages of :meth:`messages` in runs (lists, none empty): a Message record's one,
+        or a Chunk's between its definition records (one run for a chunk that defines nothing)."""
         if opcode == CHUNK:
             yield from self._chunk(offset, body)
         elif opcode in (MESSAGE, SCHEMA, CHANNEL):
             message = self._record(offset, opcode, body)
             if message is not None:
-                yield message
+                yield [message]
 
     def _record(self, offset: int, opcode: int, body: memoryview) -> RawMessage | None:
         """The message of a Message record, or None having registered a Schema or Channel."""
@@ -185,7 +191,7 @@ class Records:
             raise _Fault(f"topic {topic!r}: schema {schema_id} was never declared")
         self.channels[channel_id] = (topic, *schema, encoding)
 
-    def _chunk(self, offset: int, body: memoryview) -> Iterator[RawMessage]:
+    def _chunk(self, offset: int, body: memoryview) -> Iterator[list[RawMessage]]:
         """The messages of a Chunk record: runs of them made by one C loop (:mod:`._mcap_index`),
         which stops at each definition (read here) and at a bad message (named here)."""
         data = memoryview(self._records(offset, body))
@@ -196,7 +202,8 @@ class Records:
             except ValueError as exc:
                 reason, where = exc.args
                 raise McapFormatError(describe(offset, CHUNK, f"{reason} at byte {where}")) from None
-            yield from found
+            if found:
+                yield found
             if opcode < 0:
                 return
             length = HEADER.unpack_from(data, at)[1]

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import BinaryIO
 
 from ...errors import UserError, at, first_line
-from .chunks import mcap_messages
+from .chunks import mcap_runs
 from .messages import RawMessage
 
 MAX_RECORD_BYTES = 1 << 30
@@ -34,31 +34,45 @@ def storage_files(path: Path) -> list[Path]:
     return sorted(path.glob("*.mcap"), key=number)
 
 
-def messages(stream: BinaryIO, source: str, views: bool = False) -> Iterator[RawMessage]:
-    """The messages of an MCAP stream in file order (schemas and channels as they are defined);
-    with ``views`` each message's ``data`` is a memoryview into its decompressed chunk
-    (:mod:`.chunks`), else bytes."""
+def runs(stream: BinaryIO, source: str, views: bool = False) -> Iterator[list[RawMessage]]:
+    """The messages of an MCAP stream in file order (schemas and channels as they are defined), in
+    runs (a chunk's: :func:`.chunks.mcap_runs`); with ``views`` each message's ``data`` is a
+    memoryview into its decompressed chunk, else bytes."""
     last: RawMessage | None = None
     try:
-        for last in mcap_messages(stream, MAX_RECORD_BYTES, views):
-            yield last
+        for run in mcap_runs(stream, MAX_RECORD_BYTES, views):
+            last = run[-1]
+            yield run
     except (ValueError, OSError) as exc:  # McapFormatError, a string not UTF-8
         after = "at its start" if last is None else f"after topic {last.topic}, message at log time {last.log_time} ns"
         detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise UserError(f"not a valid MCAP file (truncated or corrupt?) {after}: {detail}", at(source)) from None
 
 
-def bag_messages(path: str | Path, views: bool = False) -> Iterator[RawMessage]:
+def messages(stream: BinaryIO, source: str, views: bool = False) -> Iterator[RawMessage]:
+    """The messages of :func:`runs`, one at a time."""
+    for run in runs(stream, source, views):
+        yield from run
+
+
+def bag_runs(path: str | Path, views: bool = False) -> Iterator[list[RawMessage]]:
     """Every message of an MCAP file or a ROS 2 bag directory, file after file (a directory of
-    ``.db3`` files through :func:`sqlite_messages`); ``views``: an MCAP message's ``data`` is a
-    memoryview into its chunk (the offline reader's batches decode it without a copy)."""
+    ``.db3`` files through :func:`sqlite_messages`, a message a run), in runs (:func:`runs`);
+    ``views``: an MCAP message's ``data`` is a memoryview into its chunk (the offline reader
+    decodes each chunk's messages as it comes, without a copy)."""
     path = Path(path)
     if path.is_dir() and not any(path.glob("*.mcap")):
-        yield from sqlite_messages(path)
+        yield from ([m] for m in sqlite_messages(path))
         return
     for file in storage_files(path):
         with open(file, "rb") as handle:
-            yield from messages(handle, str(file), views)
+            yield from runs(handle, str(file), views)
+
+
+def bag_messages(path: str | Path, views: bool = False) -> Iterator[RawMessage]:
+    """The messages of :func:`bag_runs`, one at a time."""
+    for run in bag_runs(path, views):
+        yield from run
 
 
 def sqlite_messages(path: Path) -> Iterator[RawMessage]:

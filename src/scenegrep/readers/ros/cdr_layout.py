@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _cdr_copy
+from .buffers import Group, groups
 from .cdr import _DTYPES, HEADER, Level, Payloads, _Walker
 from .msgdef import PRIMITIVE_SIZES, STRINGS, Field
 
@@ -79,6 +80,11 @@ class Layout:
     levels: dict[str, _LevelPlan]
     outputs: tuple[_Output, ...]
     copies: np.ndarray
+    row_bytes: np.ndarray = field(init=False)
+    """The bytes of one message's row of each output."""
+
+    def __post_init__(self) -> None:
+        self.row_bytes = np.array([o.row_bytes for o in self.outputs], dtype=np.int64)
 
 
 def layout(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozenset[str], raw: bytes) -> Layout:
@@ -190,35 +196,6 @@ def _blocks(fields: dict[str, tuple[str, int, list[int]]]) -> list[tuple[tuple[s
     return blocks
 
 
-@dataclass(frozen=True)
-class _Group:
-    """Messages of a batch that lie in one buffer (one decompressed chunk): ``base`` its bytes,
-    ``origins`` each message's CDR origin in it (after its encapsulation header)."""
-
-    base: np.ndarray
-    origins: np.ndarray
-
-
-def _groups(payloads: Sequence) -> tuple[int, list[_Group]] | None:
-    """The batch's payload size and its runs of messages sharing one buffer (memoryviews of one
-    chunk; bytes are copied into one buffer), or None when the payloads' sizes differ or are
-    shorter than the encapsulation header."""
-    n = len(payloads)
-    address, size, owner = (np.empty(n, np.int64) for _ in range(3))
-    _cdr_copy.addresses(payloads, address, size, owner)
-    if size[0] < HEADER or (size != size[0]).any():
-        return None
-    if set(map(type, payloads)) != {memoryview}:
-        base = np.frombuffer(b"".join(payloads), dtype=np.uint8)
-        return int(size[0]), [_Group(base, np.arange(n, dtype=np.int64) * int(size[0]) + HEADER)]
-    cuts = [0, *(np.flatnonzero(owner[1:] != owner[:-1]) + 1).tolist(), n]
-    groups = []
-    for start, end in zip(cuts, cuts[1:]):
-        base = np.frombuffer(payloads[start].obj, dtype=np.uint8)
-        groups.append(_Group(base, address[start:end] - base.__array_interface__["data"][0] + HEADER))
-    return int(size[0]), groups
-
-
 def _texts(raw: np.ndarray) -> np.ndarray:
     """Strings of zero-padded bytes (``V<n>``), decoded once per distinct value (trailing NULs
     dropped, as the generic walk decodes each)."""
@@ -227,30 +204,33 @@ def _texts(raw: np.ndarray) -> np.ndarray:
     return decoded[inverse.ravel()]
 
 
-def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level] | None:
-    """The levels of the messages of ``groups`` (all of the plan's size) in message order, or
-    None when one of them is not of layout ``plan`` (another count, or a bad header)."""
-    n = sum(len(g.origins) for g in groups)
-    columns = tuple((np.zeros if o.string else np.empty)((n, o.items, o.k), o.dtype) for o in plan.outputs)
-    row_bytes = np.array([o.row_bytes for o in plan.outputs], dtype=np.int64)
-    start = 0
-    for g in groups:
-        copied = _cdr_copy.run(
-            g.base, g.origins, plan.size, plan.count_at, plan.count_value, plan.copies, columns, row_bytes, start
-        )
-        if copied < len(g.origins):
-            return None
-        start += len(g.origins)
-    out: dict[str, Level] = {}
+def columns(plan: Layout, capacity: int) -> tuple[np.ndarray, ...]:
+    """Empty columns of ``plan`` for ``capacity`` messages (string columns zeroed: their bytes
+    past a string's end are read as padding)."""
+    return tuple((np.zeros if o.string else np.empty)((capacity, o.items, o.k), o.dtype) for o in plan.outputs)
+
+
+def copy(plan: Layout, group: Group, out: tuple[np.ndarray, ...], row: int) -> int:
+    """Copy the messages of ``group`` (all of the plan's size) into rows ``row``... of the
+    columns ``out``, in order, while they are of layout ``plan``: how many were."""
+    return _cdr_copy.run(
+        group.base, group.origins, plan.size, plan.count_at, plan.count_value, plan.copies, out, plan.row_bytes, row
+    )
+
+
+def levels_of(plan: Layout, out: tuple[np.ndarray, ...], n: int) -> dict[str, Level]:
+    """The levels of the first ``n`` rows of columns ``out`` of ``plan`` (in message order)."""
+    result: dict[str, Level] = {}
     for name, p in plan.levels.items():
         m = len(p.parent)
         message = np.repeat(np.arange(n, dtype=np.int64), m)
         parent = message
         if name:
             parent = message * len(plan.levels[p.parent_level].parent) + np.tile(np.array(p.parent, dtype=np.int64), n)
-        out[name] = Level(parent, np.tile(np.array(p.rank, dtype=np.int64), n), {})
-    for o, values in zip(plan.outputs, columns):
-        fields = out[o.level].fields
+        result[name] = Level(parent, np.tile(np.array(p.rank, dtype=np.int64), n), {})
+    for o, column in zip(plan.outputs, out):
+        values = column[:n]
+        fields = result[o.level].fields
         if o.string:
             fields[o.paths[0]] = _texts(values.reshape(n * o.items))
         elif len(o.paths) == 1:
@@ -258,7 +238,20 @@ def decode_groups(plan: Layout, groups: list[_Group]) -> dict[str, Level] | None
         else:
             block = values.reshape(n * o.items, o.k)
             fields.update((path, block[:, j]) for j, path in enumerate(o.paths))  # strided views, no copy
-    return out
+    return result
+
+
+def decode_groups(plan: Layout, groups: list[Group]) -> dict[str, Level] | None:
+    """The levels of the messages of ``groups`` (all of the plan's size) in message order, or
+    None when one of them is not of layout ``plan`` (another count, or a bad header)."""
+    n = sum(len(g.origins) for g in groups)
+    out = columns(plan, n)
+    start = 0
+    for g in groups:
+        if copy(plan, g, out, start) < len(g.origins):
+            return None
+        start += len(g.origins)
+    return levels_of(plan, out, n)
 
 
 def decode_same_layout(
@@ -272,16 +265,16 @@ def decode_same_layout(
     """The levels of a batch of one layout (that of ``cache[key]``, else of its first message,
     then kept there), or None when the batch is not of one layout (see the module docstring).
     ``payloads``: each message's bytes or a memoryview into its chunk (read in place)."""
-    found = _groups(payloads)
-    if found is None:
+    found = groups(payloads)
+    size = found[0].sizes[0]
+    if size < 0 or any((g.sizes != size).any() for g in found):
         return None
-    size, groups = found
     plan = cache.get(key)
-    levels = decode_groups(plan, groups) if plan is not None and plan.size == size - HEADER else None
+    levels = decode_groups(plan, found) if plan is not None and plan.size == size else None
     if levels is None:
         try:
             plan = cache[key] = layout(types, type_name, wanted, bytes(payloads[0][HEADER:]))
         except Unsupported:
             return None
-        levels = decode_groups(plan, groups)
+        levels = decode_groups(plan, found)
     return levels

@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _cdr_copy, _cdr_walk
-from .cdr import _DTYPES, HEADER, Level, Payloads, _Walker
+from . import _cdr_walk
+from .buffers import Group, groups
+from .cdr import _DTYPES, Level, Payloads, _Walker
 from .msgdef import PRIMITIVE_SIZES, STRINGS, Field
 
 PRIM, SKIP, STRING, SEQ_SKIP, SEQ = 1, 2, 3, 4, 5
@@ -113,40 +114,61 @@ def _texts(heap: bytes, places: np.ndarray) -> np.ndarray:
     return out
 
 
+class Walk:
+    """Batches of messages walked by ``plan`` into one set of levels, one :meth:`add` after the
+    other (each while its buffer is at hand; nothing refers to it afterwards)."""
+
+    def __init__(self, plan: Program):
+        self.plan = plan
+        count = len(plan.levels)
+        self.columns = [bytearray() for _ in plan.columns]
+        self.parents, self.ranks = [bytearray() for _ in range(count)], [bytearray() for _ in range(count)]
+        self.counts, self.reached = np.zeros(count, np.int64), np.zeros(count, np.int64)
+        self.heap = bytearray()
+        self.n = 0
+
+    def add(self, found: list[Group]) -> bool:
+        """Walk the messages of ``found`` (a batch's groups, :func:`.buffers.groups`); False, with
+        nothing added, when the walk refuses one of them (see the module docstring)."""
+        buffers = (*self.columns, *self.parents, *self.ranks, self.heap)
+        before = ([len(b) for b in buffers], self.counts.copy(), self.reached.copy())
+        n = self.n
+        for g in found:
+            walked = (g.sizes >= 0).all() and _cdr_walk.walk(
+                g.base, g.origins, g.sizes, self.plan.rows, self.columns, self.heap, self.parents, self.ranks,
+                self.counts, self.reached, n,
+            ) < 0  # fmt: skip
+            if not walked:
+                for buffer, length in zip(buffers, before[0]):
+                    del buffer[length:]
+                self.counts[:], self.reached[:] = before[1], before[2]
+                return False
+            n += len(g.origins)
+        self.n = n
+        self.counts[0] = self.reached[0] = n
+        return True
+
+    def levels(self) -> dict[str, Level]:
+        """The levels of the messages added (items in message order)."""
+        n = self.n
+        out: dict[str, Level] = {"": Level(np.arange(n, dtype=np.int64), np.zeros(n, dtype=np.int64), {})}
+        for k, (name, _) in enumerate(self.plan.levels[1:], start=1):
+            if self.reached[k]:
+                out[name] = Level(np.frombuffer(self.parents[k], np.int64), np.frombuffer(self.ranks[k], np.int64), {})
+        text = bytes(self.heap)
+        for (level, path, dtype, k), raw in zip(self.plan.columns, self.columns):
+            if level not in out or not len(out[level].parent):
+                continue
+            if dtype is None:
+                out[level].fields[path] = _texts(text, np.frombuffer(raw, np.int64).reshape(-1, 2))
+            else:
+                values = np.frombuffer(raw, dtype)
+                out[level].fields[path] = values if k == 1 else values.reshape(-1, k)
+        return out
+
+
 def decode_walked(plan: Program, payloads: Sequence) -> dict[str, Level] | None:
     """The levels of a batch (each payload its bytes or a memoryview into its chunk), or None at
     the first message the walk refuses (see the module docstring)."""
-    n = len(payloads)
-    address, size, owner = (np.empty(n, np.int64) for _ in range(3))
-    _cdr_copy.addresses(payloads, address, size, owner)
-    if (size < HEADER).any():
-        return None
-    count = len(plan.levels)
-    columns = [bytearray() for _ in plan.columns]
-    parents, ranks = [bytearray() for _ in range(count)], [bytearray() for _ in range(count)]
-    counts, reached = np.zeros(count, np.int64), np.zeros(count, np.int64)
-    counts[0] = reached[0] = n
-    heap = bytearray()
-    cuts = [0, *(np.flatnonzero(owner[1:] != owner[:-1]) + 1).tolist(), n]
-    for start, end in zip(cuts, cuts[1:]):
-        payload = payloads[start]
-        buffer = payload.obj if isinstance(payload, memoryview) else payload
-        base = np.frombuffer(buffer, dtype=np.uint8)
-        origins = address[start:end] - base.__array_interface__["data"][0] + HEADER
-        args = (columns, heap, parents, ranks, counts, reached, start)
-        if _cdr_walk.walk(base, origins, size[start:end] - HEADER, plan.rows, *args) >= 0:
-            return None
-    out: dict[str, Level] = {"": Level(np.arange(n, dtype=np.int64), np.zeros(n, dtype=np.int64), {})}
-    for k, (name, _) in enumerate(plan.levels[1:], start=1):
-        if reached[k]:
-            out[name] = Level(np.frombuffer(parents[k], np.int64), np.frombuffer(ranks[k], np.int64), {})
-    text = bytes(heap)
-    for (level, path, dtype, k), raw in zip(plan.columns, columns):
-        if level not in out or not len(out[level].parent):
-            continue
-        if dtype is None:
-            out[level].fields[path] = _texts(text, np.frombuffer(raw, np.int64).reshape(-1, 2))
-        else:
-            values = np.frombuffer(raw, dtype)
-            out[level].fields[path] = values if k == 1 else values.reshape(-1, k)
-    return out
+    walk = Walk(plan)
+    return walk.levels() if walk.add(groups(payloads)) else None

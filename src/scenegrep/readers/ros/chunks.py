@@ -16,7 +16,7 @@ from typing import BinaryIO
 
 from ..mcap_records import FOOTER, HEADER, MAGIC, McapFormatError, RawMessage, Records, check_size, describe
 
-__all__ = ["McapFormatError", "mcap_messages"]
+__all__ = ["McapFormatError", "mcap_messages", "mcap_runs"]
 
 
 def _read(stream: BinaryIO, n: int, offset: int, opcode: int | None) -> bytes:
@@ -28,10 +28,10 @@ def _read(stream: BinaryIO, n: int, offset: int, opcode: int | None) -> bytes:
     return data
 
 
-def mcap_messages(stream: BinaryIO, limit: int, views: bool = False) -> Iterator[RawMessage]:
-    """The messages of an MCAP stream in file order (see the module docstring), each one's
-    ``data`` a memoryview into its chunk when ``views``, else its own bytes; records and chunks
-    over ``limit`` bytes are refused."""
+def mcap_runs(stream: BinaryIO, limit: int, views: bool = False) -> Iterator[list[RawMessage]]:
+    """The messages of an MCAP stream in file order (see the module docstring) in runs (a chunk's,
+    :meth:`Records.runs`), each one's ``data`` a memoryview into its chunk when ``views``, else
+    its own bytes; records and chunks over ``limit`` bytes are refused."""
     if stream.read(len(MAGIC)) != MAGIC:
         raise McapFormatError("no MCAP magic at its start")
     records = Records(limit, views)
@@ -44,5 +44,11 @@ def mcap_messages(stream: BinaryIO, limit: int, views: bool = False) -> Iterator
             if stream.read(len(MAGIC)) != MAGIC:
                 raise McapFormatError("no MCAP magic after its footer")
             return
-        yield from records.messages(offset, opcode, body)
+        yield from records.runs(offset, opcode, body)
         offset += HEADER.size + length
+
+
+def mcap_messages(stream: BinaryIO, limit: int, views: bool = False) -> Iterator[RawMessage]:
+    """The messages of :func:`mcap_runs`, one at a time."""
+    for run in mcap_runs(stream, limit, views):
+        yield from run

@@ -33,13 +33,14 @@ from typing import Any
 
 import numpy as np
 
-from .cdr import Level, Payloads, decode
-from .cdr_layout import Layout, decode_same_layout
-from .cdr_walk import Program, Unsupported, decode_walked, program
+from .cdr import Level
+from .cdr_batch import CdrBatch
+from .cdr_layout import Layout
+from .cdr_walk import Program, Unsupported, program
 from .factorize import factorize
 from .foxglove import SCENE_UPDATE, decode_scene_updates
 from .messages import Boxes, Coded, ImageBoxes, RawMessage, Transforms
-from .msgdef import Field, normalise, parse_schema
+from .msgdef import DefinitionError, Field, normalise, parse_schema
 
 AUTOWARE_LABELS = (
     "UNKNOWN",
@@ -393,21 +394,55 @@ def _walk_program(
     return _PROGRAMS[cache_key]
 
 
+class TopicBatch:
+    """The messages of one topic in a batch (one supported schema and encoding) as they are added,
+    each :meth:`add` decoded at once (:mod:`.cdr_batch`: a chunk's messages read while the chunk is
+    in memory), into its boxes or links by :meth:`result`. ``capacity``: the messages expected."""
+
+    def __init__(self, first: RawMessage, capacity: int):
+        self.error: Exception | None = None
+        self.scene: list[RawMessage] | None = [] if first.schema_name == SCENE_UPDATE else None
+        self.cdr: CdrBatch | None = None
+        if self.scene is not None:
+            return
+        key = type_key(first.schema_name)
+        wanted, self.build = _DECODERS[key](first.topic) if key in IMAGE_TYPES else _DECODERS[key]()
+        try:
+            types = types_of(first.schema_name, first.schema_data)
+            cache_key = (first.schema_name, first.schema_data, wanted)
+            plan = _walk_program(types, key, wanted, cache_key)
+            self.cdr = CdrBatch(types, key, wanted, cache_key, capacity, _LAYOUTS, plan)
+        except (DefinitionError, KeyError) as exc:
+            self.error = exc
+
+    def add(self, messages: Sequence[RawMessage]) -> None:
+        """Decode the next messages of the topic (a fault is kept for :meth:`result`)."""
+        if self.error is not None:
+            return
+        if self.scene is not None:
+            self.scene.extend(messages)
+            return
+        try:
+            self.cdr.add([m.data for m in messages])  # type: ignore[union-attr]
+        except (DefinitionError, KeyError) as exc:
+            self.error = exc
+
+    def result(self) -> Boxes | ImageBoxes | Transforms:
+        """The boxes or links of the messages added: DecodeError names the first bad message (its
+        position among them); DefinitionError a schema that cannot be read; KeyError a field the
+        decoder needs that the schema lacks."""
+        if self.error is not None:
+            raise self.error
+        if self.scene is not None:
+            return decode_scene_updates(self.scene)
+        return self.build(self.cdr.levels())  # type: ignore[union-attr]
+
+
 def decode_batch(messages: Sequence[RawMessage]) -> Boxes | ImageBoxes | Transforms:
-    """The boxes or links of a batch of messages of one topic (one supported schema and encoding):
-    DecodeError names the first bad message; DefinitionError a schema that cannot be read; KeyError
-    a field the decoder needs that the schema lacks. A batch of one layout is read with strided
-    views (:mod:`.cdr_layout`), any other by the C walk (:mod:`.cdr_walk`), and a batch the walk
-    refuses by the generic walk, which names the bad message: the same boxes or links each way."""
-    first = messages[0]
-    if first.schema_name == SCENE_UPDATE:
-        return decode_scene_updates(messages)
-    key = type_key(first.schema_name)
-    wanted, build = _DECODERS[key](first.topic) if key in IMAGE_TYPES else _DECODERS[key]()
-    types = types_of(first.schema_name, first.schema_data)
-    data = [m.data for m in messages]
-    cache_key = (first.schema_name, first.schema_data, wanted)
-    levels = decode_same_layout(types, key, wanted, data, _LAYOUTS, cache_key)
-    if levels is None and (plan := _walk_program(types, key, wanted, cache_key)) is not None:
-        levels = decode_walked(plan, data)
-    return build(levels if levels is not None else decode(types, key, Payloads.of(data), wanted))
+    """The boxes or links of a batch of messages of one topic (:class:`TopicBatch`, added at
+    once). A batch of one layout is copied by C (:mod:`.cdr_layout`), any other walked in C
+    (:mod:`.cdr_walk`), and messages the walk refuses by the generic walk, which names the bad
+    message: the same boxes or links each way."""
+    batch = TopicBatch(messages[0], len(messages))
+    batch.add(messages)
+    return batch.result()

@@ -1,11 +1,14 @@
-"""Messages to frames, incrementally: batches of raw messages in, chunks of completed frames out.
+"""Messages to frames, incrementally: batches of decoded messages in, chunks of completed frames out.
 
-:class:`FrameBuilder` is the one code path of the bag reader: :meth:`FrameBuilder.feed` takes a
-batch of :class:`RawMessage` (in arrival order) and returns a :class:`LabelTrace` of the frames
-that batch completed (None if none); :meth:`FrameBuilder.finish` returns the frames left at
-the end of input. Fed one message at a time, each chunk is one frame as soon as it is
-complete; the offline reader feeds large batches through :meth:`FrameBuilder.run`, which makes
-one trace of all of them at the end (the chunks, concatenated). Rows carry object ids, classes
+:class:`FrameBuilder` is the one code path of the bag reader: a batch is a list of
+:class:`~.segments.Segment` (a topic's messages decoded, :mod:`.segments`);
+:meth:`FrameBuilder.feed` takes a batch of :class:`RawMessage` (in arrival order; the live
+reader), decodes it and returns a :class:`LabelTrace` of the frames that batch completed (None
+if none); :meth:`FrameBuilder.finish` returns the frames left at the end of input. Fed one
+message at a time, each chunk is one frame as soon as it is complete; the offline reader feeds
+batches decoded chunk by chunk (:func:`.segments.decoded_batches`) through
+:meth:`FrameBuilder.run`, which makes one trace of all of them at the end (the chunks,
+concatenated). Rows carry object ids, classes
 and frame ids as integer codes (:class:`_Names`); the strings are looked at once per distinct
 value of a batch, and the trace's objects are named once at the end.
 
@@ -44,7 +47,6 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
-from operator import itemgetter
 
 import numpy as np
 
@@ -54,27 +56,17 @@ from ...model.geometry import heading_from_atan2, heading_from_yaw
 from ...model.images import concatenate_layers
 from ...model.states import FLOAT_COLUMNS
 from ...model.trace import EGO_SIZE_UNKNOWN
-from .decoders import BOX_TYPES, LINK_TYPES, decode_batch, supported, type_key
-from .messages import Boxes, Coded, DecodeError, ImageBoxes, RawMessage
-from .msgdef import DefinitionError
+from .decoders import BOX_TYPES, LINK_TYPES, type_key
+from .messages import Boxes, Coded, ImageBoxes, RawMessage
 from .options import BagOptions
 from ._place import place
 from .columns import Column
+from .segments import STATIC_TOPIC, Segment, segments
+from .segments import fail as _fail
 from .transforms import MissingTransform, TfBuffer, yaw_of
 
 EGO_ID = "ego"
 """The object id of the ego (the pose of ``ego_frame``)."""
-
-STATIC_TOPIC = "/tf_static"
-"""The topic whose links hold at every stamp."""
-
-MAX_MESSAGE_BYTES = 256 << 20
-"""The largest message decoded (a TrackedObjects message of 1,000 objects is about 500 kB)."""
-
-
-_KIND = itemgetter(1, 4)  # a RawMessage's schema name and message encoding
-_LOG_TIME = itemgetter(5)
-_DATA = itemgetter(6)
 
 
 class _Names:
@@ -165,10 +157,6 @@ class _Rows:
         return self.number
 
 
-def _fail(topic: str, log_time: int, reason: str) -> UserError:
-    return UserError(f"topic {topic}, message at log time {log_time} ns: {reason}")
-
-
 class FrameBuilder:
     """The incremental pipeline (see the module docstring)."""
 
@@ -198,9 +186,10 @@ class FrameBuilder:
 
     # ------------------------------------------------------------------ input
     def feed(self, batch: Sequence[RawMessage]) -> LabelTrace | None:
-        """Take a batch of messages; the frames it completed, or None."""
+        """Take a batch of messages (decoded by :func:`.segments.segments`); the frames it
+        completed, or None."""
         rows = _Rows(len(self.ids))
-        self._feed(batch, rows)
+        self._feed(segments(batch, self.options), rows)
         return self._trace(rows)
 
     def finish(self) -> LabelTrace | None:
@@ -209,22 +198,20 @@ class FrameBuilder:
         self._finish(rows)
         return self._trace(rows)
 
-    def run(self, batches: Iterable[Sequence[RawMessage]]) -> LabelTrace | None:
-        """Feed every batch and finish: all the frames as one trace (the chunks :meth:`feed` and
-        :meth:`finish` would give, concatenated), or None when no frame was built. The frames'
-        rows are written into one set of growing columns; the trace is made once, at the end."""
+    def run(self, batches: Iterable[list[Segment]]) -> LabelTrace | None:
+        """Feed the segments of every batch (:func:`.segments.decoded_batches`) and finish: all the
+        frames as one trace (the chunks :meth:`feed` and :meth:`finish` would give, concatenated),
+        or None when no frame was built. The frames' rows are written into one set of growing
+        columns; the trace is made once, at the end."""
         rows = _Rows(len(self.ids))
         for batch in batches:
             self._feed(batch, rows)
         self._finish(rows)
         return self._trace(rows)
 
-    def _feed(self, batch: Sequence[RawMessage], rows: _Rows) -> None:
-        by_topic: dict[str, list[RawMessage]] = {}
-        for message in batch:
-            by_topic.setdefault(message.topic, []).append(message)
-        for topic, messages in by_topic.items():
-            self._topic(topic, messages)
+    def _feed(self, batch: list[Segment], rows: _Rows) -> None:
+        for segment in batch:
+            self._segment(segment)
         self._emit(False, rows)
 
     def _finish(self, rows: _Rows) -> None:
@@ -235,35 +222,15 @@ class FrameBuilder:
         if self.late:
             self.note(f"{self.late} box messages arrived after their frame was built and were dropped")
 
-    def _topic(self, topic: str, messages: list[RawMessage]) -> None:
-        first = messages[0]
-        kind = type_key(first.schema_name)
-        if not supported(first.schema_name, first.message_encoding):
-            self.skipped.setdefault(topic, f"{first.schema_name}, {first.message_encoding or 'no'} encoding")
-            return
-        chosen = not self.options.topics or topic in self.options.topics
-        if not chosen and not (kind == "tf2_msgs/TFMessage" and topic in ("/tf", STATIC_TOPIC)):
-            return
-        kinds = list(map(_KIND, messages))
-        if max(map(len, map(_DATA, messages))) > MAX_MESSAGE_BYTES or kinds.count(kinds[0]) != len(kinds):
-            for m in messages:  # the first bad message
-                if len(m.data) > MAX_MESSAGE_BYTES:
-                    raise _fail(topic, m.log_time, f"a message of {len(m.data)} bytes (at most {MAX_MESSAGE_BYTES})")
-                if (m.schema_name, m.message_encoding) != (first.schema_name, first.message_encoding):
-                    raise _fail(topic, m.log_time, f"type {m.schema_name} on a topic of type {first.schema_name}")
-        try:
-            decoded = decode_batch(messages)
-        except DecodeError as exc:
-            raise _fail(topic, messages[exc.message].log_time, exc.reason) from None
-        except DefinitionError as exc:
-            raise _fail(topic, first.log_time, f"schema {first.schema_name}: {exc}") from None
-        except KeyError as exc:
-            raise _fail(topic, first.log_time, f"schema {first.schema_name} has no field {exc.args[0]}") from None
-        if kind in LINK_TYPES:
-            self.tf.add(decoded, static=topic == STATIC_TOPIC)  # type: ignore[arg-type]
+    def _segment(self, segment: Segment) -> None:
+        kind, decoded = type_key(segment.schema_name), segment.decoded
+        if decoded is None:
+            encoding = segment.message_encoding or "no"
+            self.skipped.setdefault(segment.topic, f"{segment.schema_name}, {encoding} encoding")
+        elif kind in LINK_TYPES:
+            self.tf.add(decoded, static=segment.topic == STATIC_TOPIC)  # type: ignore[arg-type]
         elif kind in BOX_TYPES:
-            log_times = np.fromiter(map(_LOG_TIME, messages), dtype=np.int64, count=len(messages))
-            self._boxes(topic, decoded, log_times)  # type: ignore[arg-type]
+            self._boxes(segment.topic, decoded, segment.log_times)  # type: ignore[arg-type]
 
     def _boxes(self, topic: str, boxes: Boxes | ImageBoxes, log_times: np.ndarray) -> None:
         if self.frame_topic is None and self.options.rate is None:
@@ -682,11 +649,11 @@ def _distinct(stamps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def frames(
-    batches: Iterable[Sequence[RawMessage]],
+    batches: Iterable[list[Segment]],
     options: BagOptions,
     name: str,
     source: TraceSource | None = None,
     note: Callable[[str], None] | None = None,
 ) -> LabelTrace | None:
-    """Every frame of the batches of messages as one trace, or None (:meth:`FrameBuilder.run`)."""
+    """Every frame of the batches of segments as one trace, or None (:meth:`FrameBuilder.run`)."""
     return FrameBuilder(options, name, source, note).run(batches)

@@ -1,40 +1,30 @@
 """The ``ros-bag`` format: MCAP files and ROS 2 bag directories read into one label trace.
 
-:func:`read_traces` runs the incremental pipeline (:mod:`.framing`) over a bag's messages in
-batches to the end: the bag's frames as one trace. Options (topics, frame topic or rate, map and ego frames) are a
+:func:`read_traces` runs the incremental pipeline over a bag's messages to the end: each chunk's
+messages decoded as it is read, in batches (:func:`.segments.decoded_batches`), framed
+(:mod:`.framing`): the bag's frames as one trace. Options (topics, frame topic or rate, map and ego frames) are a
 :class:`BagOptions`, by default those in force (:func:`.options.current`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
-from itertools import islice
+from collections.abc import Iterator
 from pathlib import Path
 
 from ...errors import UserError, at
 from ...model import LabelTrace, TraceSource
-from .bag import bag_messages
+from .bag import bag_runs
 from .framing import frames
-from .messages import RawMessage
 from .options import BagOptions, current
+from .segments import decoded_batches
 
 FORMAT = "ros-bag"
-
-BATCH = 1024
-"""Messages decoded together by the offline reader."""
-
-
-def batches(messages: Iterable[RawMessage], size: int = BATCH) -> Iterator[list[RawMessage]]:
-    """``messages`` in lists of ``size`` (the last may be shorter)."""
-    iterator = iter(messages)
-    while batch := list(islice(iterator, size)):
-        yield batch
-
 
 def read_traces(path: str | Path, options: BagOptions | None = None) -> Iterator[LabelTrace]:
     """The bag's trace, or nothing when it holds no box message to build a frame from."""
     source = TraceSource(str(path), FORMAT)
-    trace = frames(batches(bag_messages(path, views=True)), options or current(), Path(path).stem, source)
+    options = options or current()
+    trace = frames(decoded_batches(bag_runs(path, views=True), options), options, Path(path).stem, source)
     if trace is not None:
         yield trace
 

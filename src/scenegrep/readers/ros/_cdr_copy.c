@@ -3,10 +3,11 @@
  * (cdr_layout.py), in C. Python plans (once per layout) what to check and what to copy; these
  * functions run the plan over every message of a batch, so no Python runs per message or field.
  *
- * addresses(payloads, address, size, owner)
- *     For each buffer of the sequence `payloads` (bytes, memoryviews), its first byte's address,
- *     its length and its owner (for a memoryview the object it views, else itself), written into
- *     the int64 buffers address, size, owner (each as long as payloads).
+ * locate(payloads, offset, size) -> list of (start, owner)
+ *     For each buffer of the sequence `payloads` (bytes, memoryviews), its owner (for a
+ *     memoryview the object it views, else itself), its first byte's offset in its owner's
+ *     buffer and its length, the last two written into the int64 buffers offset and size (each
+ *     as long as payloads). Returns the runs of payloads of one owner: (index of the first, owner).
  *
  * run(base, origins, size, count_at, count_value, copies, outputs, row_bytes, row0) -> int
  *     `base` holds messages whose CDR origins (after the 4-byte encapsulation header) are at
@@ -35,41 +36,56 @@ static int get(PyObject *obj, Py_buffer *view, int writable, Py_ssize_t item, co
     return 0;
 }
 
-static PyObject *addresses(PyObject *self, PyObject *args) {
+static PyObject *locate(PyObject *self, PyObject *args) {
     (void)self;
-    PyObject *payloads, *a_obj, *s_obj, *o_obj;
-    if (!PyArg_ParseTuple(args, "OOOO", &payloads, &a_obj, &s_obj, &o_obj)) return NULL;
+    PyObject *payloads, *o_obj, *s_obj;
+    if (!PyArg_ParseTuple(args, "OOO", &payloads, &o_obj, &s_obj)) return NULL;
     PyObject *seq = PySequence_Fast(payloads, "payloads must be a sequence");
     if (!seq) return NULL;
     Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
-    Py_buffer a, s, o;
-    if (get(a_obj, &a, 1, 8, "address") < 0) { Py_DECREF(seq); return NULL; }
-    if (get(s_obj, &s, 1, 8, "size") < 0) { PyBuffer_Release(&a); Py_DECREF(seq); return NULL; }
-    if (get(o_obj, &o, 1, 8, "owner") < 0) {
-        PyBuffer_Release(&a); PyBuffer_Release(&s); Py_DECREF(seq); return NULL;
-    }
-    PyObject *result = NULL;
-    if (a.len / 8 < n || s.len / 8 < n || o.len / 8 < n) {
+    Py_buffer o, s;
+    if (get(o_obj, &o, 1, 8, "offset") < 0) { Py_DECREF(seq); return NULL; }
+    if (get(s_obj, &s, 1, 8, "size") < 0) { PyBuffer_Release(&o); Py_DECREF(seq); return NULL; }
+    PyObject *runs = PyList_New(0), *result = NULL, *owner = NULL;
+    const char *start = NULL;
+    Py_ssize_t owner_len = 0;
+    if (!runs) goto done;
+    if (o.len / 8 < n || s.len / 8 < n) {
         PyErr_SetString(PyExc_ValueError, "output buffers shorter than the payloads");
         goto done;
     }
-    int64_t *address = a.buf, *size = s.buf, *owner = o.buf;
+    int64_t *offset = o.buf, *size = s.buf;
     PyObject **items = PySequence_Fast_ITEMS(seq);
     for (Py_ssize_t i = 0; i < n; i++) {
         PyObject *item = items[i];
+        PyObject *base = PyMemoryView_Check(item) ? PyMemoryView_GET_BASE(item) : NULL;
+        base = base ? base : item;
+        if (base != owner) {
+            Py_buffer whole;
+            if (PyObject_GetBuffer(base, &whole, PyBUF_SIMPLE) < 0) goto done;
+            start = whole.buf;
+            owner_len = whole.len;
+            PyBuffer_Release(&whole);
+            owner = base;
+            PyObject *run = Py_BuildValue("(nO)", i, owner);
+            if (!run || PyList_Append(runs, run) < 0) { Py_XDECREF(run); goto done; }
+            Py_DECREF(run);
+        }
         Py_buffer view;
         if (PyObject_GetBuffer(item, &view, PyBUF_SIMPLE) < 0) goto done;
-        address[i] = (int64_t)(intptr_t)view.buf;
+        offset[i] = (int64_t)((const char *)view.buf - start);
         size[i] = (int64_t)view.len;
-        PyObject *base = PyMemoryView_Check(item) ? PyMemoryView_GET_BASE(item) : NULL;
-        owner[i] = (int64_t)(intptr_t)(base ? base : item);
         PyBuffer_Release(&view);
+        if (offset[i] < 0 || offset[i] + size[i] > owner_len) {
+            PyErr_SetString(PyExc_ValueError, "a payload outside its owner's buffer");
+            goto done;
+        }
     }
-    result = Py_NewRef(Py_None);
+    result = Py_NewRef(runs);
 done:
-    PyBuffer_Release(&a);
-    PyBuffer_Release(&s);
+    Py_XDECREF(runs);
     PyBuffer_Release(&o);
+    PyBuffer_Release(&s);
     Py_DECREF(seq);
     return result;
 }
@@ -156,7 +172,7 @@ done:
 }
 
 static PyMethodDef methods[] = {
-    {"addresses", addresses, METH_VARARGS, "addresses(payloads, address, size, owner): see the module comment"},
+    {"locate", locate, METH_VARARGS, "locate(payloads, offset, size) -> [(start, owner)]: see the module comment"},
     {"run", run, METH_VARARGS, "run(base, origins, size, count_at, count_value, copies, outputs, row_bytes, row0)"},
     {NULL, NULL, 0, NULL},
 };

@@ -30,17 +30,17 @@ class Group:
 
 
 def groups(payloads: Sequence) -> list[Group]:
-    """The payloads (each message's bytes or a memoryview into its chunk) in groups, in order."""
+    """The payloads (each message's bytes or a memoryview into its chunk) in groups, in order:
+    one per run of payloads of one owner, unless runs are short (payloads of their own, as bytes
+    are): then one buffer of them all, joined."""
     n = len(payloads)
-    address, size, owner = np.empty((3, n), np.int64)
-    _cdr_copy.addresses(payloads, address, size, owner)
-    if not all(type(p) is memoryview for p in payloads):
+    offset, size = np.empty((2, n), np.int64)
+    runs = _cdr_copy.locate(payloads, offset, size)
+    if len(runs) > 1 and 4 * len(runs) > n:
         base = np.frombuffer(b"".join(payloads), dtype=np.uint8)
         return [Group(base, np.cumsum(size) - size + HEADER, size - HEADER, 0)]
-    cuts = [0, *(np.flatnonzero(owner[1:] != owner[:-1]) + 1).tolist(), n]
-    out = []
-    for start, end in zip(cuts, cuts[1:]):
-        base = np.frombuffer(payloads[start].obj, dtype=np.uint8)
-        origin = address[start:end] - base.__array_interface__["data"][0] + HEADER
-        out.append(Group(base, origin, size[start:end] - HEADER, start))
-    return out
+    ends = [start for start, _ in runs[1:]] + [n]
+    return [
+        Group(np.frombuffer(owner, dtype=np.uint8), offset[start:end] + HEADER, size[start:end] - HEADER, start)
+        for (start, owner), end in zip(runs, ends)
+    ]

@@ -82,6 +82,8 @@ class Layout:
     copies: np.ndarray
     row_bytes: np.ndarray = field(init=False)
     """The bytes of one message's row of each output."""
+    items: dict[str, tuple[int, np.ndarray, np.ndarray]] = field(init=False, default_factory=dict)
+    """Per level, the parents and ranks of its items in the last number of messages decoded."""
 
     def __post_init__(self) -> None:
         self.row_bytes = np.array([o.row_bytes for o in self.outputs], dtype=np.int64)
@@ -220,14 +222,7 @@ def copy(plan: Layout, group: Group, out: tuple[np.ndarray, ...], row: int) -> i
 
 def levels_of(plan: Layout, out: tuple[np.ndarray, ...], n: int) -> dict[str, Level]:
     """The levels of the first ``n`` rows of columns ``out`` of ``plan`` (in message order)."""
-    result: dict[str, Level] = {}
-    for name, p in plan.levels.items():
-        m = len(p.parent)
-        message = np.repeat(np.arange(n, dtype=np.int64), m)
-        parent = message
-        if name:
-            parent = message * len(plan.levels[p.parent_level].parent) + np.tile(np.array(p.parent, dtype=np.int64), n)
-        result[name] = Level(parent, np.tile(np.array(p.rank, dtype=np.int64), n), {})
+    result = {name: Level(*_items(plan, name, n), {}) for name in plan.levels}
     for o, column in zip(plan.outputs, out):
         values = column[:n]
         fields = result[o.level].fields
@@ -239,6 +234,22 @@ def levels_of(plan: Layout, out: tuple[np.ndarray, ...], n: int) -> dict[str, Le
             block = values.reshape(n * o.items, o.k)
             fields.update((path, block[:, j]) for j, path in enumerate(o.paths))  # strided views, no copy
     return result
+
+
+def _items(plan: Layout, name: str, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The parent and rank of every item of level ``name`` of ``n`` messages of ``plan`` (read-only;
+    the last ``n``'s kept in the plan: batches are mostly of one size)."""
+    found = plan.items.get(name)
+    if found is None or found[0] != n:
+        p = plan.levels[name]
+        message = np.repeat(np.arange(n, dtype=np.int64), len(p.parent))
+        parent = message
+        if name:
+            parent = message * len(plan.levels[p.parent_level].parent) + np.tile(np.array(p.parent, dtype=np.int64), n)
+        rank = np.tile(np.array(p.rank, dtype=np.int64), n)
+        parent.flags.writeable = rank.flags.writeable = False
+        found = plan.items[name] = (n, parent, rank)
+    return found[1], found[2]
 
 
 def decode_groups(plan: Layout, groups: list[Group]) -> dict[str, Level] | None:

@@ -37,7 +37,7 @@ from .cdr import Level
 from .cdr_batch import CdrBatch
 from .cdr_layout import Layout
 from .cdr_walk import Program, Unsupported, program
-from .factorize import factorize
+from .factorize import by_object, factorize
 from .foxglove import SCENE_UPDATE, decode_scene_updates
 from .messages import Boxes, Coded, ImageBoxes, RawMessage, Transforms
 from .msgdef import DefinitionError, Field, normalise, parse_schema
@@ -75,9 +75,11 @@ def _stamp(fields: dict[str, np.ndarray], prefix: str = "header.stamp.") -> np.n
 
 
 def _frames(names: np.ndarray) -> np.ndarray:
-    out = np.empty(len(names), dtype=object)
-    out[:] = [str(n).lstrip("/") for n in names]
-    return out
+    """Frame ids without their leading slashes, each distinct string object stripped once."""
+    codes, first = by_object(names)
+    stripped = np.empty(len(first), dtype=object)
+    stripped[:] = [str(n).lstrip("/") for n in names[first]]
+    return stripped[codes]
 
 
 def _ordered(level: Level) -> np.ndarray | slice:
@@ -90,8 +92,32 @@ def _ordered(level: Level) -> np.ndarray | slice:
     return np.lexsort((level.rank, level.parent))
 
 
+def _block(columns: list[np.ndarray]) -> np.ndarray | None:
+    """The float64 columns as one (n, k) view when they lie side by side in one array (the
+    fields of one block of a layout's copy, :mod:`.cdr_layout`), else None."""
+    first = columns[0]
+    if first.dtype != np.float64 or first.ndim != 1 or first.strides[0] < 8 * len(columns):
+        return None
+    start = first.__array_interface__["data"][0]
+    for j, column in enumerate(columns):
+        if (
+            column.dtype != np.float64
+            or column.shape != first.shape
+            or column.strides != first.strides
+            or column.base is None
+            or column.base is not first.base
+            or column.__array_interface__["data"][0] != start + 8 * j
+        ):
+            return None
+    return np.lib.stride_tricks.as_strided(first, (len(first), len(columns)), (first.strides[0], 8), writeable=False)
+
+
 def _vector(fields: dict[str, np.ndarray], prefix: str, names: Sequence[str], rows: np.ndarray | slice) -> np.ndarray:
-    """The fields ``prefix + name`` of ``rows`` as the float64 columns of one (n, len(names)) array."""
+    """The fields ``prefix + name`` of ``rows`` as the float64 columns of one (n, len(names)) array:
+    a read-only view when they lie side by side in one array and ``rows`` is a slice."""
+    block = _block([fields[prefix + n] for n in names])
+    if block is not None:
+        return block[rows]
     columns = [fields[prefix + n][rows] for n in names]
     out = np.empty((len(columns[0]), len(names)))
     for j, column in enumerate(columns):
@@ -136,6 +162,9 @@ def _best_class(levels: dict[str, Level], n_objects: int) -> np.ndarray:
 def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:
     size = _vector(fields, "shape.dimensions.", _XYZ, rows)
     kind = fields["shape.type"][rows]
+    if (kind == 0).all():  # boxes: their dimensions as they are
+        return size
+    size = size.copy()
     size[kind == 1, 1] = size[kind == 1, 0]
     size[kind == 2, :2] = np.nan
     size[kind > 2] = np.nan
@@ -185,7 +214,7 @@ def _autoware(tracked: bool) -> tuple[frozenset[str], Callable[[dict[str, Level]
         if tracked:
             ids = _uuid_text(f["object_id.uuid"][rows])
         else:
-            velocity[f["kinematics.has_twist"][rows] == 0] = np.nan
+            velocity = np.where(f["kinematics.has_twist"][rows, None] == 0, np.nan, velocity)
             ids = np.array([f"{s}:{r}" for s, r in zip(stamps[message], objects.rank[rows])], dtype=object)
         return Boxes(
             message,

@@ -20,6 +20,7 @@ from .segments import decoded_batches
 
 FORMAT = "ros-bag"
 
+
 def read_traces(path: str | Path, options: BagOptions | None = None) -> Iterator[LabelTrace]:
     """The bag's trace, or nothing when it holds no box message to build a frame from."""
     source = TraceSource(str(path), FORMAT)

@@ -243,15 +243,18 @@ def crossings(lw: Linework, px, py, qx, qy, only=None) -> tuple[np.ndarray, np.n
     index = np.flatnonzero(moving)
     if not len(index):
         return np.zeros(0, np.intp), np.zeros(0)
-    p = np.stack([px, py], 1)[index]
-    r = np.stack([qx, qy], 1)[index] - p
+    p = np.stack([px, py], 1).take(index, axis=0)
+    r = np.stack([qx, qy], 1).take(index, axis=0) - p
     if only is None:
         segments = shapely.linestrings(np.stack([p, p + r], axis=1))
         walk, line = lw.tree.query(segments)
         pair_walk, pair = lw.pair_tree.query(segments)
     else:
         walk, line, pair_walk, pair = _near_only(lw, p, r, np.asarray(only)[index])
-    found_walk, found_t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])
+    start = lw.start.take(line, axis=0)
+    found_walk, found_t = _segment_crossings(
+        p.take(walk, axis=0), r.take(walk, axis=0), start, lw.end.take(line, axis=0) - start
+    )
     tie_walk, tie_t, _ = _ties(lw, p, r, pair_walk, pair)
     found_walk = np.concatenate([walk[found_walk], tie_walk])
     found_t = np.concatenate([found_t, tie_t])
@@ -294,7 +297,7 @@ def _ties(lw: Linework, p: np.ndarray, r: np.ndarray, walk: np.ndarray, pair: np
     equally near p + t r (of segment ``walk[h]``)."""
     if not len(pair):
         return walk, np.zeros(0), pair
-    tie_t, tie = _equal_distances(lw, p[walk], r[walk], pair)
+    tie_t, tie = _equal_distances(lw, p.take(walk, axis=0), r.take(walk, axis=0), pair)
     return walk[tie], tie_t, pair[tie]
 
 
@@ -316,8 +319,8 @@ def _distance_pieces(polylines: Polylines, segment: np.ndarray, p, r) -> tuple[n
     """Squared distance from p + t r to each segment, as three quadratics in t (coefficients
     [piece, (t², t, 1)]: nearest to the start vertex, to the interior, to the end vertex), and
     the segment parameter of the foot of the perpendicular, (s0, s1) with s = s0 + s1 t."""
-    a = polylines.start[segment]
-    w = polylines.end[segment] - a
+    a = polylines.start.take(segment, axis=0)
+    w = polylines.end.take(segment, axis=0) - a
     pa = p - a
     pb = pa - w
     left, right = np.concatenate([w, r, pa, pa, pb, pb, pa, r]), np.concatenate([w, r, r, pa, r, pb, w, w])
@@ -336,21 +339,22 @@ def _equal_distances(lw: Linework, p, r, pair) -> tuple[np.ndarray, np.ndarray]:
     lane's reach, and no segment of their centreline is nearer (where the nearest segment may jump
     between them)."""
     n = len(pair)
-    quads, foot = _distance_pieces(lw.polylines, lw.pairs[pair].T.ravel(), np.tile(p, (2, 1)), np.tile(r, (2, 1)))
-    qi = quads[:n]
+    quads, foot = _distance_pieces(
+        lw.polylines, lw.pairs.take(pair, axis=0).T.ravel(), np.tile(p, (2, 1)), np.tile(r, (2, 1))
+    )
     coefficient = np.moveaxis(quads, 2, 0)
     a, b, c = coefficient[:, :n, :, None] - coefficient[:, n:, None, :]
     roots = _quadratic_roots(a, b, c)
     flat = np.flatnonzero((roots > 0) & (roots < 1))
     t = roots.reshape(-1)[flat]
     hit, piece_i, piece_j = flat // 18, flat // 6 % 3, flat // 2 % 3
-    valid = _in_piece(foot[hit], piece_i, t) & _in_piece(foot[n + hit], piece_j, t)
+    valid = _in_piece(foot.take(hit, axis=0), piece_i, t) & _in_piece(foot.take(n + hit, axis=0), piece_j, t)
     hit, piece_i, t = hit[valid], piece_i[valid], t[valid]
-    quad = qi[hit, piece_i]
+    quad = quads.reshape(-1, 3).take(hit * 3 + piece_i, axis=0)
     own = np.sqrt(np.maximum(quad[:, 0] * t * t + quad[:, 1] * t + quad[:, 2], 0.0))
     within = own <= lw.pair_reach[pair[hit]]
     hit, t, own = hit[within], t[within], own[within]
-    points = shapely.points(p[hit] + t[:, None] * r[hit])
+    points = shapely.points(p.take(hit, axis=0) + t[:, None] * r.take(hit, axis=0))
     nearest = shapely.distance(points, lw.polylines.geometries[lw.pair_lane[pair[hit]]])
     keep = own <= nearest + TIE_M
     return t[keep], hit[keep]
@@ -363,7 +367,7 @@ def _wrap(angle: np.ndarray) -> np.ndarray:
 def _in_piece(s: np.ndarray, piece: np.ndarray, t: np.ndarray) -> np.ndarray:
     """Whether the foot parameter s0 + s1 t lies in the range of the distance piece (with slack)."""
     foot = s[:, 0] + s[:, 1] * t
-    low, high = PIECE_RANGE[piece].T
+    low, high = PIECE_RANGE.take(piece, axis=0).T
     return (foot >= low) & (foot <= high)
 
 

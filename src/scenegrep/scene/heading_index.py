@@ -9,10 +9,11 @@ bin its headings' neighbourhoods (within twice :data:`WINDOW_RAD`) touch, in one
 plane of strips, one per bin: bin b's boxes are shifted along x by b strip widths (a strip is
 wider than the items' extent by twice :data:`MARGIN_M`). A query's box, its x range clipped to
 the items' extent (widened by half the margin, so it meets the same items) and shifted to its
-heading's bin, meets only boxes of that bin. The tree's boxes are grown by a slack larger than the
-rounding of the shifted coordinates, so the tree returns a superset; a query then keeps each item
-whose box meets its own (closed intervals on the unshifted coordinates, as the R-tree's envelope
-test) and one of whose headings lies within the caller's window of it (at most
+heading's bin, meets only boxes of that bin. The tree's boxes are grown along x by a slack larger
+than the rounding of the shifted coordinates, so the tree returns a superset (along y, unshifted,
+its closed-interval test is exact); a query then keeps each item whose box meets its own along x
+(closed intervals on the unshifted coordinates, as the R-tree's envelope test) and one of whose
+headings lies within the caller's window of it (at most
 :data:`WINDOW_RAD`, modulo 2π): exactly what the R-tree query followed by that heading test
 finds. Items wanted for every heading (the inverted walk's area boundaries) are filed once in one
 more strip, which every query also looks up. One lookup serves any mix of items (the inverted
@@ -79,9 +80,7 @@ def heading_index(headings: np.ndarray, bounds: np.ndarray, everywhere: np.ndarr
     filed = np.concatenate([filed, np.flatnonzero(everywhere) * (BINS + 1) + BINS])
     item, strip = (filed // (BINS + 1)).astype(np.intp), filed % (BINS + 1)
     offset, box = strip * width + shift, bounds[item]
-    tree = shapely.STRtree(
-        shapely.box(box[:, 0] + offset - slack, box[:, 1] - slack, box[:, 2] + offset + slack, box[:, 3] + slack)
-    )
+    tree = shapely.STRtree(shapely.box(box[:, 0] + offset - slack, box[:, 1], box[:, 2] + offset + slack, box[:, 3]))
     half = MARGIN_M / 2
     return HeadingIndex(tree, item, strip == BINS, headings, bounds, low - half, high + half, shift, width)
 
@@ -99,12 +98,15 @@ def near_heading(
     strip = np.mod(_bin(np.mod(heading, 2 * np.pi)), BINS)
     if index.everywhere.any():
         strip, bounds, heading = np.append(strip, np.full(n, BINS)), np.tile(bounds, (2, 1)), np.tile(heading, 2)
-    x = np.clip(bounds[:, 0::2], index.low, index.high) + (strip * index.width + index.shift)[:, None]
-    query, entry = index.tree.query(shapely.box(x[:, 0], bounds[:, 1], x[:, 1], bounds[:, 3]))
+    corners = np.empty((len(bounds), 2, 2))
+    corners[:, :, 0] = np.clip(bounds[:, 0::2], index.low, index.high) + (strip * index.width + index.shift)[:, None]
+    corners[:, :, 1] = bounds[:, 1::2]
+    query, entry = index.tree.query(shapely.linestrings(corners))
     item = index.item[entry]
-    mine, theirs = bounds[query], index.bounds[item]
-    meet = np.all((mine[:, :2] <= theirs[:, 2:]) & (theirs[:, :2] <= mine[:, 2:]), axis=1)
-    turn = np.abs(np.mod(index.heading[item] - heading[query][:, None] + np.pi, 2 * np.pi) - np.pi)
+    meet = (bounds[:, 0].take(query) <= index.bounds[:, 2].take(item)) & (
+        index.bounds[:, 0].take(item) <= bounds[:, 2].take(query)
+    )
+    turn = np.abs(np.mod(index.heading.take(item, axis=0) - heading.take(query)[:, None] + np.pi, 2 * np.pi) - np.pi)
     keep = np.flatnonzero(meet & (index.everywhere[entry] | np.any(turn <= window, axis=1)))
     return query[keep] % max(n, 1), item[keep]
 

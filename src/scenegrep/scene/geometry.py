@@ -464,9 +464,11 @@ class MapGeometry:
         return None
 
     @cached_property
-    def _intersection_areas(self) -> tuple[STRtree, np.ndarray, np.ndarray]:
+    def _intersection_areas(self) -> tuple[STRtree, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """An R-tree of the intersection areas, their lanes' indices (in the map's order) one area
-        after another, and where each area's lanes start in that array (one past the last at the end)."""
+        after another, where each area's lanes start in that array (one past the last at the end),
+        and each (area, lane) membership as ``area * lanes + lane``, sorted, with the lane's first
+        position in the area's list."""
         road_map = self._require_map()
         index = road_map.lane_index
         areas = list(road_map.intersections)
@@ -475,7 +477,12 @@ class MapGeometry:
         flat = np.array([lane for group in lanes for lane in group], dtype=np.intp)
         polygons = np.array([a.polygon for a in areas], dtype=object)
         shapely.prepare(polygons)
-        return STRtree(polygons), flat, starts
+        owner = np.repeat(np.arange(len(areas)), np.diff(starts))
+        position = np.arange(len(flat)) - starts[owner]
+        member = owner * np.int64(len(road_map.lanes)) + flat
+        order = np.lexsort((position, member))
+        first = _firsts(member[order])
+        return STRtree(polygons), flat, starts, member[order][first], position[order][first]
 
     def scenic_headings(self, field: Field, x: np.ndarray, y: np.ndarray, value: Values) -> np.ndarray:
         """The one heading Scenic itself computes for the field at each point (used to walk along it).
@@ -566,11 +573,12 @@ class MapGeometry:
 
     def _intersection_choice(self, points: np.ndarray, lane: np.ndarray, reach: float, inside: np.ndarray) -> None:
         """Points (shapely) in an intersection area (or within ``reach`` metres of one) take the first
-        of its lanes containing them, else the nearest (the first such intersection area counts):
-        set in ``lane``. ``inside``: every lane containing each point, as ``point * lanes + lane``
-        sorted (the caller has found them; none for points in no lane)."""
+        of its lanes containing them, else the nearest (the first such intersection area counts; of
+        equally near lanes the first): set in ``lane``. ``inside``: every lane containing each
+        point, as ``point * lanes + lane`` sorted (the caller has found them; none for points in no
+        lane), so only points in none of their area's lanes are measured against them."""
         road_map = self._require_map()
-        tree, flat, starts = self._intersection_areas
+        tree, flat, starts, member, rank = self._intersection_areas
         if not len(flat):
             return
         if reach > 0:
@@ -580,19 +588,23 @@ class MapGeometry:
         if not len(point):
             return
         point, area = _first_per_point(point, area)
+        lanes = np.int64(len(road_map.lanes))
+        first = np.full(len(point), len(flat))
+        if len(inside):
+            held = inside // lanes
+            k = np.minimum(np.searchsorted(point, held), len(point) - 1)
+            code = area[k] * lanes + inside % lanes
+            at = np.minimum(np.searchsorted(member, code), len(member) - 1)
+            hit = (point[k] == held) & (member[at] == code)
+            np.minimum.at(first, k[hit], rank[at[hit]])
+        held = first < len(flat)
+        lane[point[held]] = flat[starts[area[held]] + first[held]]
+        point, area = point[~held], area[~held]
         counts = starts[area + 1] - starts[area]
         group = np.repeat(np.arange(len(point)), counts)
         position = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
         candidates = flat[starts[area][group] + position]
-        here = points[point[group]]
-        code = point[group] * np.int64(len(road_map.lanes)) + candidates
-        at = np.minimum(np.searchsorted(inside, code), max(len(inside) - 1, 0))
-        score = np.where(inside[at] == code, -1.0, 0.0) if len(inside) else np.zeros(len(code))
-        outside = np.flatnonzero(score == 0)
-        inside = np.zeros(len(point), dtype=bool)
-        inside[group[score < 0]] = True
-        outside = outside[~inside[group[outside]]]
-        score[outside] = shapely.distance(road_map.lane_polygons[candidates[outside]], here[outside])
+        score = shapely.distance(road_map.lane_polygons[candidates], points[point[group]])
         order = np.lexsort((position, score, group))
         best = order[_firsts(group[order])]
         lane[point[group[best]]] = candidates[best]

@@ -5,8 +5,10 @@ An overlay of a line with a multi-part geometry nodes the whole geometry, so it 
 line that meets one small part as for one that crosses them all; a line whose box meets one part's
 box is cut by that part alone, which gives the same geometry (the other parts lie elsewhere: the
 overlay finds the same crossings with the same edges), and a line whose box meets several parts'
-is cut by the whole domain, as before. Each domain's parts and their R-tree are built once per
-domain object (kept while it lives).
+is cut by the whole domain, as before. A line of some length inside the domain, clear of its
+boundary (most of a walk's starts in an intersection area), is its own part inside: the overlay
+returns it as it is, so it is not computed (a line of no length, the overlay drops). Each
+domain's parts and their R-tree are built once per domain object (kept while it lives).
 """
 
 from __future__ import annotations
@@ -24,9 +26,11 @@ def clipped(lines: np.ndarray, domains) -> np.ndarray:
     every = np.empty(len(lines), dtype=object)
     every[:] = [domains] * len(lines) if isinstance(domains, shapely.Geometry) else list(domains)
     found = np.empty(len(lines), dtype=object)
-    whole = shapely.get_num_geometries(every) < 2
+    inside = shapely.contains_properly(every, lines) & (shapely.length(lines) > 0)
+    found[inside] = lines[inside]
+    whole = ~inside & (shapely.get_num_geometries(every) < 2)
     found[whole] = shapely.intersection(lines[whole], every[whole])
-    multi = np.flatnonzero(~whole)
+    multi = np.flatnonzero(~inside & ~whole)
     keys = np.array([id(d) for d in every[multi]], dtype=np.int64)
     for key in np.unique(keys).tolist():
         rows = multi[keys == key]

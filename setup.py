@@ -11,6 +11,6 @@ setup(ext_modules=[Extension("scenegrep.readers._strem", ["src/scenegrep/readers
                    Extension("scenegrep.readers.ros._cdr_walk", ["src/scenegrep/readers/ros/_cdr_walk.c"],
                              extra_compile_args=FLAGS),
                    Extension("scenegrep.readers.ros._place", ["src/scenegrep/readers/ros/_place.c"],
-                             extra_compile_args=FLAGS),
+                             extra_compile_args=[*FLAGS, "-ffp-contract=off"]),
                    Extension("scenegrep.scene._reach", ["src/scenegrep/scene/_reach.c"],
                              extra_compile_args=[*FLAGS, "-ffp-contract=off"])])

@@ -14,7 +14,8 @@
  *     atan2: the caller takes it with numpy's vectorised atan2, several times faster than a
  *     call per box, and makes it the heading), length, width, height (size as is), vx, vy
  *     (velocity turned by turn * quat). The formulas and their order of operations are those
- *     of transforms.py (product, rotated, yaw), so the results are theirs bit for bit. Shapes,
+ *     of transforms.py (product, rotated, yaw), so the results are theirs bit for bit (built
+ *     with -ffp-contract=off: no fused multiply-adds where the target has them). Shapes,
  *     dtypes and every index of `each` and `dest` are checked before anything is written
  *     (ValueError otherwise).
  */

@@ -2,23 +2,26 @@
 or walked as the chunk is read) against the generic walk over the whole batch: random
 TrackedObjects of one to three layouts in small MCAP chunks, a stale cached layout or none, a
 walk or none (so the parts are layout + walk, or layout + generic), columns that must grow, and at
-times a truncated message (refused with the generic walk's position and reason); and the segments
-of a bag cut into runs anyhow are those of the whole batch at once."""
+times a truncated message (refused with the generic walk's position and reason); the segments of a
+bag cut into runs anyhow are those of the whole batch at once; UUIDs numbered by their bytes in
+order of first appearance; the most probable row of each item as numpy's argmax picks it."""
 
 from __future__ import annotations
 
 import io
+import uuid
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from scenegrep.readers.ros.cdr import CdrError, Payloads, decode
+from scenegrep.readers.ros.cdr import CdrError, Level, Payloads, decode
 from scenegrep.readers.ros.cdr_batch import CdrBatch
 from scenegrep.readers.ros.cdr_layout import layout
 from scenegrep.readers.ros.cdr_walk import program
 from scenegrep.readers.ros.chunks import mcap_runs
+from scenegrep.readers.ros.decoders import _best, _uuid_text
 from scenegrep.readers.ros.options import BagOptions
 from scenegrep.readers.ros.segments import Decoder, segments
 
@@ -83,3 +86,26 @@ def test_the_segments_of_runs_are_those_of_the_whole_batch(pool, picks, cuts):
     assert [s.topic for s in parts] == [s.topic for s in whole] == [TOPIC]
     np.testing.assert_array_equal(parts[0].log_times, whole[0].log_times)
     _same_boxes(parts[0].decoded, whole[0].decoded)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.integers(0, 5), max_size=300), st.integers(1, 4))
+def test_uuid_codes_number_the_distinct_keys_in_order_of_first_appearance(picks, spread):
+    keys = np.zeros((len(picks), 16), dtype=np.uint8)
+    keys[:, 15 - spread] = picks  # keys differing in one byte, anywhere
+    coded = _uuid_text(keys)
+    first = {}
+    for i, p in enumerate(picks):
+        first.setdefault(p, i)
+    assert coded.codes.tolist() == [list(first).index(p) for p in picks]
+    assert coded.strings().tolist() == [str(uuid.UUID(bytes=bytes(k))) for k in keys]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 12), st.lists(st.integers(0, 3), min_size=1, max_size=120))
+def test_the_best_of_each_item_is_numpys_first_largest(per, values):
+    items = max(len(values) // per, 1)
+    v = np.resize(np.array(values, dtype=np.float32), items * per)
+    level = Level(np.repeat(np.arange(items), per), np.tile(np.arange(per), items), {"p": v})
+    expected = np.argmax(v.reshape(items, per), axis=1) + np.arange(items) * per
+    assert _best(level, "p", items).tolist() == expected.tolist()

@@ -9,6 +9,11 @@
  *     buffer and its length, the last two written into the int64 buffers offset and size (each
  *     as long as payloads). Returns the runs of payloads of one owner: (index of the first, owner).
  *
+ * codes16(keys, codes, first) -> k
+ *     The n 16-byte keys of `keys` (n * 16 bytes) numbered in order of first appearance: codes[i]
+ *     (int64) the number of key i, first[c] (int64) the first row of number c (c < k, the count of
+ *     distinct keys, returned). Keys are compared whole.
+ *
  * run(base, origins, size, count_at, count_value, copies, outputs, row_bytes, row0) -> int
  *     `base` holds messages whose CDR origins (after the 4-byte encapsulation header) are at
  *     `origins` (int64), each `size` bytes from there. For message i in order: its
@@ -22,6 +27,7 @@
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define N_OUTPUTS_MAX 256
@@ -155,7 +161,18 @@ static PyObject *run(PyObject *self, PyObject *args) {
         if (j < m) break;
         for (Py_ssize_t k = 0; k < p; k++) {
             const int64_t *c = copy + 4 * k;
-            memcpy((char *)out[c[1]].buf + (row0 + i) * row_bytes[c[1]] + c[2], msg + c[0], (size_t)c[3]);
+            char *to = (char *)out[c[1]].buf + (row0 + i) * row_bytes[c[1]] + c[2];
+            const unsigned char *from = msg + c[0];
+            switch (c[3]) { /* the common sizes as fixed-size copies (inlined) */
+            case 1: memcpy(to, from, 1); break;
+            case 4: memcpy(to, from, 4); break;
+            case 8: memcpy(to, from, 8); break;
+            case 16: memcpy(to, from, 16); break;
+            case 24: memcpy(to, from, 24); break;
+            case 32: memcpy(to, from, 32); break;
+            case 56: memcpy(to, from, 56); break;
+            default: memcpy(to, from, (size_t)c[3]);
+            }
         }
     }
     Py_END_ALLOW_THREADS
@@ -171,7 +188,63 @@ done:
     return result;
 }
 
+/* Codes of 16-byte keys in order of first appearance, by open addressing (a table of a power of
+ * two at least twice the rows); every key is compared whole, so equal codes are equal keys. */
+static PyObject *codes16(PyObject *self, PyObject *args) {
+    (void)self;
+    PyObject *raw_obj, *codes_obj, *first_obj;
+    if (!PyArg_ParseTuple(args, "OOO", &raw_obj, &codes_obj, &first_obj)) return NULL;
+    Py_buffer raw, codes, first;
+    if (get(raw_obj, &raw, 0, 16, "keys") < 0) return NULL;
+    if (get(codes_obj, &codes, 1, 8, "codes") < 0) { PyBuffer_Release(&raw); return NULL; }
+    if (get(first_obj, &first, 1, 8, "first") < 0) {
+        PyBuffer_Release(&raw); PyBuffer_Release(&codes); return NULL;
+    }
+    PyObject *result = NULL;
+    Py_ssize_t n = raw.len / 16, size = 16;
+    int64_t *table = NULL;
+    if (codes.len / 8 < n || first.len / 8 < n) {
+        PyErr_SetString(PyExc_ValueError, "codes or first shorter than the keys");
+        goto done;
+    }
+    while (size < 2 * n) size *= 2;
+    table = malloc((size_t)size * sizeof(int64_t));
+    if (!table) { PyErr_NoMemory(); goto done; }
+    memset(table, 0xff, (size_t)size * sizeof(int64_t));
+    const unsigned char *key = raw.buf;
+    int64_t *code = codes.buf, *row = first.buf, k = 0;
+    for (Py_ssize_t i = 0; i < n; i++) {
+        uint64_t a, b;
+        memcpy(&a, key + 16 * i, 8);
+        memcpy(&b, key + 16 * i + 8, 8);
+        uint64_t h = (a ^ (b * 0x9E3779B97F4A7C15ULL)) * 0xBF58476D1CE4E5B9ULL;
+        Py_ssize_t at = (Py_ssize_t)((h >> 29) & (uint64_t)(size - 1));
+        for (;;) {
+            int64_t held = table[at];
+            if (held < 0) {
+                table[at] = k;
+                row[k] = i;
+                code[i] = k++;
+                break;
+            }
+            if (!memcmp(key + 16 * row[held], key + 16 * i, 16)) {
+                code[i] = held;
+                break;
+            }
+            at = (at + 1) & (size - 1);
+        }
+    }
+    result = PyLong_FromLongLong(k);
+done:
+    free(table);
+    PyBuffer_Release(&raw);
+    PyBuffer_Release(&codes);
+    PyBuffer_Release(&first);
+    return result;
+}
+
 static PyMethodDef methods[] = {
+    {"codes16", codes16, METH_VARARGS, "codes16(keys, codes, first) -> k: see the module comment"},
     {"locate", locate, METH_VARARGS, "locate(payloads, offset, size) -> [(start, owner)]: see the module comment"},
     {"run", run, METH_VARARGS, "run(base, origins, size, count_at, count_value, copies, outputs, row_bytes, row0)"},
     {NULL, NULL, 0, NULL},

@@ -37,7 +37,8 @@ from .cdr import Level
 from .cdr_batch import CdrBatch
 from .cdr_layout import Layout
 from .cdr_walk import Program, Unsupported, program
-from .factorize import by_object, factorize
+from . import _cdr_copy
+from .factorize import by_object
 from .foxglove import SCENE_UPDATE, decode_scene_updates
 from .messages import Boxes, Coded, ImageBoxes, RawMessage, Transforms
 from .msgdef import DefinitionError, Field, normalise, parse_schema
@@ -132,19 +133,33 @@ def _best(level: Level | None, score: str, n_items: int) -> np.ndarray:
     best = np.full(n_items, -1, dtype=np.int64)
     if level is None or not len(level.parent):
         return best
-    values = level.fields[score].astype(np.float64)
+    values = level.fields[score]
+    values = values if values.dtype.kind == "f" else values.astype(np.float64)
     per = len(values) // n_items
     if (
         per * n_items == len(values)
-        and (level.parent == np.repeat(np.arange(n_items), per)).all()
-        and (level.rank == np.tile(np.arange(per), n_items)).all()
+        and (level.parent.reshape(n_items, per) == np.arange(n_items)[:, None]).all()
+        and (level.rank.reshape(n_items, per) == np.arange(per)).all()
         and not np.isnan(values).any()
-    ):
-        return np.argmax(values.reshape(n_items, per), axis=1) + np.arange(n_items) * per
+    ):  # (the values compared as they are: a float32 orders as its float64)
+        return _argmax_rows(values.reshape(n_items, per)) + np.arange(n_items) * per
+    values = values.astype(np.float64)
     order = np.lexsort((level.rank, -values, level.parent))
     parent = level.parent[order]
     first = np.r_[True, parent[1:] != parent[:-1]]
     best[parent[first]] = order[first]
+    return best
+
+
+def _argmax_rows(values: np.ndarray) -> np.ndarray:
+    """Per row of (n, per) values without NaN, the column of its first largest value (a pass per
+    column when there are few: numpy's argmax along a short axis costs a call per row)."""
+    if values.shape[1] > 8:
+        return np.argmax(values, axis=1)
+    best, top = np.zeros(len(values), dtype=np.int64), values[:, 0]
+    for j in range(1, values.shape[1]):
+        better = values[:, j] > top
+        best[better], top = j, np.where(better, values[:, j], top)
     return best
 
 
@@ -171,23 +186,29 @@ def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:
     return size
 
 
+_UUID_TEXTS: dict[bytes, str] = {}
+"""Canonical texts of the UUIDs seen (kept across batches; emptied past :data:`_UUIDS_KEPT`)."""
+_UUIDS_KEPT = 1 << 16
+
+
 def _uuid_text(raw: np.ndarray) -> Coded:
-    """Canonical UUID strings of (n, 16) bytes, as codes into the distinct ones (each formatted
-    once). Rows are numbered by one 64-bit key per UUID (its two words mixed) without a sort
-    (:func:`.factorize.factorize`), checked against the UUIDs themselves; two UUIDs of one key
-    are told apart by a sort of the 16 bytes."""
+    """Canonical UUID strings of (n, 16) bytes, as codes into the distinct ones in order of first
+    appearance (numbered in C by the 16 bytes, :func:`._cdr_copy.codes16`; each text formatted
+    once, and kept for the next batches)."""
     raw = np.ascontiguousarray(raw, dtype=np.uint8)
-    words = raw.view("<u8").reshape(len(raw), 2)
-    key = (words[:, 0] ^ (words[:, 1] * np.uint64(0x9E3779B97F4A7C15))).view(np.int64)
-    codes, first = factorize(key)
-    if not (words == words[first][codes]).all():
-        _, first, codes = np.unique(raw.view("V16").ravel(), return_index=True, return_inverse=True)
-        codes = codes.ravel()
+    codes, first = np.empty(len(raw), np.int64), np.empty(len(raw), np.int64)
+    k = _cdr_copy.codes16(raw, codes, first)
+    if len(_UUID_TEXTS) > _UUIDS_KEPT:
+        _UUID_TEXTS.clear()
     texts = []
-    for value in raw[first]:
-        h = bytes(value).hex()
-        texts.append(f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:]}")
-    names = np.empty(len(texts), dtype=object)
+    for value in raw[first[:k]]:
+        key = value.tobytes()
+        text = _UUID_TEXTS.get(key)
+        if text is None:
+            h = key.hex()
+            text = _UUID_TEXTS[key] = f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:]}"
+        texts.append(text)
+    names = np.empty(k, dtype=object)
     names[:] = texts
     return Coded(codes, names)
 

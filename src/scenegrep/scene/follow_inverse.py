@@ -223,41 +223,42 @@ def _holders(road_map, with_shoulders: bool) -> np.ndarray:
     holding it, else the nearest of them; a point in no such area the first lane holding it; a
     point in no lane and no such area a shoulder holding it, else the nearest lane of an area
     within Scenic's tolerance, else the nearest lane or the first shoulder within it. So a lane
-    holds: in each area listing it, its part that no lane listed before it covers, and the
-    area's part outside its lanes; itself outside those areas (inside areas without lanes too);
-    and, outside every lane, the band of :data:`HOLD_BAND_M` around itself and its areas (around
-    a shoulder, for a shoulder)."""
+    holds: in each area listing it, its part that no lane listed before it covers, the area's
+    part outside its lanes, and the rim of :data:`HOLD_BAND_M` around the area; itself outside
+    those areas (inside areas without lanes too); and the rim of :data:`HOLD_BAND_M` around
+    itself. A shoulder holds itself and the rim around it. (The rims may reach into other lanes,
+    where those lanes' directions count instead: a few more candidates, for no overlay with
+    every lane near each.)"""
     polygons = road_map.lane_polygons
     index = road_map.lane_index
     areas = road_map.intersections
     listed = [[index[lane] for lane in a.lanes if lane in index] for a in areas]
     bare = shapely.union_all([a.polygon for a, lanes in zip(areas, listed) if not lanes])
-    gaps = [shapely.difference(a.polygon, shapely.union_all(polygons[lanes])) for a, lanes in zip(areas, listed)]
-    tree = road_map._lane_tree
+    outer = [
+        shapely.union_all([shapely.difference(a.polygon, shapely.union_all(polygons[lanes])), _rim(a.polygon)])
+        for a, lanes in zip(areas, listed)
+    ]
     holds = []
     for k in range(len(polygons)):
-        parts, own = [], []
-        for a, lanes, gap in zip(areas, listed, gaps):
+        parts, own = [_rim(polygons[k])], []
+        for a, lanes, rest in zip(areas, listed, outer):
             if k not in lanes:
                 continue
             first = shapely.intersection(polygons[k], a.polygon)
-            parts += [shapely.difference(first, shapely.union_all(polygons[lanes[: lanes.index(k)]])), gap]
+            parts += [shapely.difference(first, shapely.union_all(polygons[lanes[: lanes.index(k)]])), rest]
             own.append(a.polygon)
         parts.append(shapely.difference(polygons[k], shapely.difference(shapely.union_all(own), bare)))
-        parts.append(
-            _outside_lanes(shapely.buffer(shapely.union_all([polygons[k], *own]), HOLD_BAND_M), tree, polygons)
-        )
         holds.append(shapely.union_all(parts))
     if with_shoulders:
-        holds += [_outside_lanes(shapely.buffer(a.polygon, HOLD_BAND_M), tree, polygons) for a in road_map.shoulders]
+        holds += [shapely.buffer(a.polygon, HOLD_BAND_M) for a in road_map.shoulders]
     found = np.array(holds, dtype=object)
     shapely.prepare(found)
     return found
 
 
-def _outside_lanes(zone: shapely.Geometry, tree: shapely.STRtree, polygons: np.ndarray) -> shapely.Geometry:
-    """The part of ``zone`` in no lane."""
-    return shapely.difference(zone, shapely.union_all(polygons[tree.query(zone)]))
+def _rim(polygon: shapely.Geometry) -> shapely.Geometry:
+    """The band of :data:`HOLD_BAND_M` around a polygon, outside it."""
+    return shapely.difference(shapely.buffer(polygon, HOLD_BAND_M), polygon)
 
 
 def _neighbours(lines: Polylines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

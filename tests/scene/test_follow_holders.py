@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
-from scenegrep.scene.follow_inverse import HOLD_SLACK_M, inverse
+from scenegrep.scene.follow_inverse import inverse
 from tests.scene.test_follow import FIELD
 from tests.scene.test_follow_start import town01
 
@@ -58,7 +58,7 @@ def test_every_point_lies_in_the_holding_region_of_the_centreline_giving_its_hea
         np.cumsum((last - first)[taken]) - (last - first)[taken], (last - first)[taken]
     )
     segment = order[first[point] + offset]
-    held = shapely.dwithin(shapely.points(points[point]), inv.holds[inv.owner[segment]], HOLD_SLACK_M)
+    held = shapely.intersects(inv.holds[inv.owner[segment]], shapely.points(points[point]))
     inside = np.zeros(len(points), dtype=bool)
     inside[point[held]] = True
     assert inside[taken].all(), points[taken[~inside[taken]]][:5]

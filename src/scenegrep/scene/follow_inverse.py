@@ -100,8 +100,9 @@ take its direction (metres): Scenic's tolerance (:data:`~.geometry.ELEMENT_REACH
 room for the buffer's chords (1.2 mm at 0.06 m)."""
 
 HOLD_SLACK_M = 1e-6
-"""How near a swept segment must come to a lane's holding region to keep its headings (metres:
-slack for rounding)."""
+"""How far the holding regions are grown (metres: slack for rounding; at least 0.98 of it where the
+buffer's chords cut its round corners): a swept segment that meets the grown region keeps its
+heading."""
 
 
 DOMAIN_SLACK_M = 1e-6
@@ -217,8 +218,9 @@ def _build_inverse(geometry: MapGeometry) -> Inverse:
 
 
 def _holders(road_map, with_shoulders: bool) -> np.ndarray:
-    """Per lane (then per shoulder, ``with_shoulders``): a region (prepared) holding every point
-    whose road direction :meth:`~.geometry.MapGeometry.scenic_headings` reads off its centreline.
+    """Per lane (then per shoulder, ``with_shoulders``): a region (prepared, grown by
+    :data:`HOLD_SLACK_M`) holding every point whose road direction
+    :meth:`~.geometry.MapGeometry.scenic_headings` reads off its centreline.
     A point of an intersection area with lanes takes the first of its lanes (in the area's order)
     holding it, else the nearest of them; a point in no such area the first lane holding it; a
     point in no lane and no such area a shoulder holding it, else the nearest lane of an area
@@ -251,7 +253,7 @@ def _holders(road_map, with_shoulders: bool) -> np.ndarray:
         holds.append(shapely.union_all(parts))
     if with_shoulders:
         holds += [shapely.buffer(a.polygon, HOLD_BAND_M) for a in road_map.shoulders]
-    found = np.array(holds, dtype=object)
+    found = shapely.buffer(np.array(holds, dtype=object), HOLD_SLACK_M)
     shapely.prepare(found)
     return found
 
@@ -425,7 +427,7 @@ def _within(inv: Inverse, x, y, lo, hi, ax, ay, segment, held) -> tuple[np.ndarr
     n = len(segment)
     start, end = np.full(len(px), np.inf), np.full(len(px), -np.inf)
     zero = shapely.linestrings(np.stack([px[n:], py[n:], qx[n:], qy[n:]], axis=1).reshape(-1, 2, 2))
-    off = n + np.flatnonzero(~shapely.covered_by(zero, inv.roads))
+    off = n + np.flatnonzero(~shapely.covers(inv.roads, zero))
     start[off], end[off] = lo[off], hi[off]
     box = inv.near[segment]
     meet = np.flatnonzero(
@@ -446,7 +448,7 @@ def _within(inv: Inverse, x, y, lo, hi, ax, ay, segment, held) -> tuple[np.ndarr
     test = hit[held[hit]]
     swept = np.stack([x[test] + start[test] * ax[test], y[test] + start[test] * ay[test]], axis=1)
     swept = np.stack([swept, np.stack([x[test] + end[test] * ax[test], y[test] + end[test] * ay[test]], axis=1)], 1)
-    away = test[~shapely.dwithin(shapely.linestrings(swept), inv.holds[inv.owner[segment[test]]], HOLD_SLACK_M)]
+    away = test[~shapely.intersects(inv.holds[inv.owner[segment[test]]], shapely.linestrings(swept))]
     start[away], end[away] = np.inf, -np.inf
     return start, end
 

@@ -138,17 +138,32 @@ def _best(level: Level | None, score: str, n_items: int) -> np.ndarray:
     per = len(values) // n_items
     if (
         per * n_items == len(values)
-        and (level.parent.reshape(n_items, per) == np.arange(n_items)[:, None]).all()
-        and (level.rank.reshape(n_items, per) == np.arange(per)).all()
+        and all(np.array_equal(level.parent[j::per], _count(n_items)) for j in range(per))
+        and all((level.rank[j::per] == j).all() for j in range(per))
         and not np.isnan(values).any()
-    ):  # (the values compared as they are: a float32 orders as its float64)
-        return _argmax_rows(values.reshape(n_items, per)) + np.arange(n_items) * per
+    ):  # (the values compared as they are: a float32 orders as its float64; columns of the
+        # (n_items, per) rows compared one at a time: numpy loops slowly along a short axis)
+        if per == 1:
+            return _count(n_items)
+        return _argmax_rows(values.reshape(n_items, per)) + _count(n_items) * per
     values = values.astype(np.float64)
     order = np.lexsort((level.rank, -values, level.parent))
     parent = level.parent[order]
     first = np.r_[True, parent[1:] != parent[:-1]]
     best[parent[first]] = order[first]
     return best
+
+
+_COUNT = np.arange(0)
+
+
+def _count(n: int) -> np.ndarray:
+    """0, 1, ..., n-1 (int64; a read-only view of one kept array, grown as needed)."""
+    global _COUNT
+    if len(_COUNT) < n:
+        _COUNT = np.arange(max(n, 2 * len(_COUNT)), dtype=np.int64)
+        _COUNT.flags.writeable = False
+    return _COUNT[:n]
 
 
 def _argmax_rows(values: np.ndarray) -> np.ndarray:
@@ -168,10 +183,14 @@ def _best_class(levels: dict[str, Level], n_objects: int) -> np.ndarray:
     classification or past the known labels)."""
     classes = levels.get("objects.classification")
     best = _best(classes, "probability", n_objects)
-    label = np.zeros(n_objects, dtype=np.int64)
-    if (best >= 0).any():  # (a level of no rows has no fields)
-        label[best >= 0] = classes.fields["label"][best[best >= 0]]
-    return np.where(label < len(AUTOWARE_LABELS), label, 0)
+    found = best >= 0
+    if found.all() and len(best):  # every object has a classification
+        label = classes.fields["label"][best]
+    else:
+        label = np.zeros(n_objects, dtype=np.int64)
+        if found.any():  # (a level of no rows has no fields)
+            label[found] = classes.fields["label"][best[found]]
+    return np.where(label < len(AUTOWARE_LABELS), label, 0).astype(np.int64)
 
 
 def _shape_size(fields: dict[str, np.ndarray], rows: np.ndarray) -> np.ndarray:

@@ -13,4 +13,6 @@ setup(ext_modules=[Extension("scenegrep.readers._strem", ["src/scenegrep/readers
                    Extension("scenegrep.readers.ros._place", ["src/scenegrep/readers/ros/_place.c"],
                              extra_compile_args=[*FLAGS, "-ffp-contract=off"]),
                    Extension("scenegrep.scene._reach", ["src/scenegrep/scene/_reach.c"],
+                             extra_compile_args=[*FLAGS, "-ffp-contract=off"]),
+                   Extension("scenegrep.model._project", ["src/scenegrep/model/_project.c"],
                              extra_compile_args=[*FLAGS, "-ffp-contract=off"])])

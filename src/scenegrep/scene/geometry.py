@@ -517,7 +517,7 @@ class MapGeometry:
         if len(off):
             chosen[off] = self._off_lanes(x[off], y[off], points[off])
         on = np.flatnonzero(lane >= 0)
-        chosen[on] = road_map.centreline_polylines.direction_at(lane[on], x[on], y[on], points[on])
+        chosen[on] = road_map.centreline_polylines.direction_at(lane[on], x[on], y[on])
         return chosen
 
     @cached_property
@@ -543,7 +543,7 @@ class MapGeometry:
         shoulders = self._shoulders
         if shoulders is not None:
             point, shoulder = _first_per_point(*_containing(shoulders[0], points))
-            chosen[point] = shoulders[1].direction_at(shoulder, x[point], y[point], points[point])
+            chosen[point] = shoulders[1].direction_at(shoulder, x[point], y[point])
             elsewhere = np.ones(len(x), dtype=bool)
             elsewhere[point] = False
             rest = np.flatnonzero(elsewhere)
@@ -561,14 +561,12 @@ class MapGeometry:
             near = shapely.distance(road_map.lane_polygons[nearest], points[rest[free]]) <= ELEMENT_REACH_M
             lane[free[near]] = nearest[near]
         on = np.flatnonzero(lane >= 0)
-        chosen[rest[on]] = road_map.centreline_polylines.direction_at(
-            lane[on], x[rest[on]], y[rest[on]], points[rest[on]]
-        )
+        chosen[rest[on]] = road_map.centreline_polylines.direction_at(lane[on], x[rest[on]], y[rest[on]])
         free = rest[lane < 0]
         if len(free) and shoulders is not None:
             tree, lines = shoulders
             point, shoulder = _first_per_point(*tree.query(points[free], predicate="dwithin", distance=ELEMENT_REACH_M))
-            chosen[free[point]] = lines.direction_at(shoulder, x[free[point]], y[free[point]], points[free[point]])
+            chosen[free[point]] = lines.direction_at(shoulder, x[free[point]], y[free[point]])
         return chosen
 
     def _intersection_choice(self, points: np.ndarray, lane: np.ndarray, reach: float, inside: np.ndarray) -> None:

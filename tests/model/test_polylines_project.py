@@ -89,3 +89,15 @@ def test_no_countable_distance_and_bad_input():
     with pytest.raises(ValueError, match="no such polyline"):
         polylines.arc_at(np.array([-1]), np.array([0.0]), np.array([0.0]))
     assert len(polylines.arc_at(np.zeros(0, int), np.zeros(0), np.zeros(0))) == 0
+
+
+def test_single_point_polyline_has_no_segment():
+    """A polyline whose vertices all repeat has no segment: no arc (-1) and no direction (a
+    ValueError, not another polyline's segment); the others still answer."""
+    polylines = Polylines([np.array([[2.0, 2.0], [2.0, 2.0]]), np.array([[0.0, 0.0], [1.0, 0.0]])])
+    np.testing.assert_array_equal(
+        polylines.arc_at(np.array([0, 1]), np.array([0.5, 0.5]), np.array([0.5, 0.5])), [-1, 0.5]
+    )
+    with pytest.raises(ValueError, match="single point"):
+        polylines.direction_at(np.array([1, 0]), np.array([0.5, 0.5]), np.array([0.5, 0.5]))
+    assert polylines.direction_at(np.array([1]), np.array([0.5]), np.array([0.5]))[0] == -np.pi / 2  # east

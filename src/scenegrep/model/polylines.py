@@ -74,8 +74,11 @@ class Polylines:
 
     def segment_at(self, line: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Index (into the flat segment arrays) of the segment of polyline ``line[i]`` nearest
-        to point i, by projection (Scenic's rule: the segment holding :meth:`arc_at`)."""
+        to point i, by projection (Scenic's rule: the segment holding :meth:`arc_at`). ValueError
+        for a polyline of a single point (no segment)."""
         line = np.asarray(line, dtype=np.intp)
+        if not self.count[line].all():
+            raise ValueError("a polyline of a single point has no direction")
         arc = self.arc_at(line, x, y)
         low, high = self.first[line], self.first[line] + np.maximum(self.count[line] - 1, 0)
         found = np.clip(np.searchsorted(self.arc_end, arc + self.base[line], side="left"), low, high)

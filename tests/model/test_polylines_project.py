@@ -101,3 +101,13 @@ def test_single_point_polyline_has_no_segment():
     with pytest.raises(ValueError, match="single point"):
         polylines.direction_at(np.array([1, 0]), np.array([0.5, 0.5]), np.array([0.5, 0.5]))
     assert polylines.direction_at(np.array([1]), np.array([0.5]), np.array([0.5]))[0] == -np.pi / 2  # east
+
+
+def test_no_segment_is_guessed_for_a_point_without_a_finite_distance():
+    """A NaN, infinite or overflowing point has no nearest segment: a ValueError, never the
+    polyline's first segment; finite points beside it would answer."""
+    polylines = Polylines([np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])])
+    for x, y in ((np.nan, 0.0), (np.inf, 0.0), (1e200, 1e200)):
+        with pytest.raises(ValueError, match="no finite distance"):
+            polylines.segment_at(np.zeros(2, int), np.array([1.0, x]), np.array([0.5, y]))
+    assert polylines.segment_at(np.zeros(1, int), np.array([1.0]), np.array([0.5]))[0] == 1

@@ -75,11 +75,14 @@ class Polylines:
     def segment_at(self, line: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Index (into the flat segment arrays) of the segment of polyline ``line[i]`` nearest
         to point i, by projection (Scenic's rule: the segment holding :meth:`arc_at`). ValueError
-        for a polyline of a single point (no segment)."""
+        for a polyline of a single point (no segment) and for a point with no finite distance to
+        its polyline (NaN, infinite or beyond about 1e154 m): no segment is guessed for it."""
         line = np.asarray(line, dtype=np.intp)
         if not self.count[line].all():
             raise ValueError("a polyline of a single point has no direction")
         arc = self.arc_at(line, x, y)
+        if (arc < 0).any():
+            raise ValueError("a point with no finite distance to its polyline has no nearest segment")
         low, high = self.first[line], self.first[line] + np.maximum(self.count[line] - 1, 0)
         found = np.clip(np.searchsorted(self.arc_end, arc + self.base[line], side="left"), low, high)
         # the global search can be off by one at ties; settle them on the per-line arc lengths,

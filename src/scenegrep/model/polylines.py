@@ -27,6 +27,7 @@ class Polylines:
         counts = np.array([max(len(line) - 1, 0) for line in cleaned], dtype=np.intp)
         self.first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.intp) if len(counts) else counts
         self.count = counts
+        self.last = self.first + np.maximum(counts - 1, 0)
         starts = [line[:-1] for line in cleaned if len(line) > 1]
         ends = [line[1:] for line in cleaned if len(line) > 1]
         self.start = np.concatenate(starts) if starts else np.zeros((0, 2))
@@ -83,14 +84,14 @@ class Polylines:
         arc = self.arc_at(line, x, y)
         if (arc < 0).any():
             raise ValueError("a point with no finite distance to its polyline has no nearest segment")
-        low, high = self.first[line], self.first[line] + np.maximum(self.count[line] - 1, 0)
-        found = np.clip(np.searchsorted(self.arc_end, arc + self.base[line], side="left"), low, high)
+        low, high = self.first.take(line), self.last.take(line)
+        found = np.minimum(np.maximum(np.searchsorted(self.arc_end, arc + self.base.take(line)), low), high)
         # the global search can be off by one at ties; settle them on the per-line arc lengths,
         # summed as Scenic sums them: the first segment whose end is at or beyond the arc
         previous = np.maximum(found - 1, low)
-        found = np.where((found > low) & (arc <= self.local_end[previous]), previous, found)
+        found = np.where((found > low) & (arc <= self.local_end.take(previous)), previous, found)
         following = np.minimum(found + 1, high)
-        return np.where((found < high) & (arc > self.local_end[found]), following, found)
+        return np.where((found < high) & (arc > self.local_end.take(found)), following, found)
 
     def direction_at(self, line: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """Heading (radians) of polyline ``line[i]`` at point i (its nearest segment's heading)."""

@@ -394,10 +394,11 @@ def _candidates(inv: Inverse, ex, ey, b: _Back, held: np.ndarray) -> _Moved:
     )
     near, segment = inv.tree.query(boxes)
     steps = b.steps[near]
-    ax = np.concatenate([b.ax[near] + inv.step[segment, 0] / steps, b.ax + 0.0])
-    ay = np.concatenate([b.ay[near] + inv.step[segment, 1] / steps, b.ay + -1.0 / b.steps])
+    step = inv.step.take(segment, axis=0)
+    ax = np.concatenate([b.ax.take(near) + step[:, 0] / steps, b.ax + 0.0])
+    ay = np.concatenate([b.ay.take(near) + step[:, 1] / steps, b.ay + -1.0 / b.steps])
     branch = np.concatenate([near, np.arange(len(b.row))])
-    heading = np.concatenate([inv.heading[segment], np.zeros(len(b.row))])
+    heading = np.concatenate([inv.heading.take(segment), np.zeros(len(b.row))])
     lo, hi = _within(inv, x[branch], y[branch], b.lo[branch], b.hi[branch], ax, ay, segment, held[near])
     keep = np.flatnonzero(lo <= hi)
     order = keep[np.lexsort((heading[keep], branch[keep]))]
@@ -429,7 +430,7 @@ def _within(inv: Inverse, x, y, lo, hi, ax, ay, segment, held) -> tuple[np.ndarr
     zero = shapely.linestrings(np.stack([px[n:], py[n:], qx[n:], qy[n:]], axis=1).reshape(-1, 2, 2))
     off = n + np.flatnonzero(~shapely.covers(inv.roads, zero))
     start[off], end[off] = lo[off], hi[off]
-    box = inv.near[segment]
+    box = inv.near.take(segment, axis=0)
     meet = np.flatnonzero(
         (np.minimum(px[:n], qx[:n]) <= box[:, 2])
         & (np.maximum(px[:n], qx[:n]) >= box[:, 0])
@@ -439,8 +440,9 @@ def _within(inv: Inverse, x, y, lo, hi, ax, ay, segment, held) -> tuple[np.ndarr
     p = np.stack([px[meet], py[meet]], axis=1)
     r = np.stack([qx[meet], qy[meet]], axis=1) - p
     s = segment[meet]
-    a, z = inv.ends[s, :2], inv.ends[s, 2:]
-    t_lo, t_hi = _narrowed(p, r, a, z, inv.reach[s], inv.unit[s], inv.before[s], inv.after[s])
+    ends = inv.ends.take(s, axis=0)
+    unit, before, after = (v.take(s, axis=0) for v in (inv.unit, inv.before, inv.after))
+    t_lo, t_hi = _narrowed(p, r, ends[:, :2], ends[:, 2:], inv.reach.take(s), unit, before, after)
     hit = meet[t_lo <= t_hi]  # elsewhere t_hi may be -inf, and -inf * 0 (a point interval) is NaN
     t_lo, t_hi = t_lo[t_lo <= t_hi], t_hi[t_lo <= t_hi]
     width = hi[hit] - lo[hit]

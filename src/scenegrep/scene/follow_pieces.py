@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass, fields
+from functools import cache
 from typing import Self
 
 import numpy as np
@@ -115,7 +116,13 @@ class _Columns:
 
     def take(self, index: np.ndarray) -> Self:
         """The rows at ``index``, as a new instance of the same class."""
-        return type(self)(*(getattr(self, f.name)[index] for f in fields(self)))
+        return type(self)(*(getattr(self, name)[index] for name in _names(type(self))))
+
+
+@cache
+def _names(kind: type) -> tuple[str, ...]:
+    """The field names of a dataclass, in order."""
+    return tuple(f.name for f in fields(kind))
 
 
 @dataclass

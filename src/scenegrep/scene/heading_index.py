@@ -97,7 +97,8 @@ def near_heading(
     n = len(bounds)
     strip = np.mod(_bin(np.mod(heading, 2 * np.pi)), BINS)
     if index.everywhere.any():
-        strip, bounds, heading = np.append(strip, np.full(n, BINS)), np.tile(bounds, (2, 1)), np.tile(heading, 2)
+        strip = np.append(strip, np.full(n, BINS))
+        bounds, heading = np.concatenate([bounds, bounds]), np.concatenate([heading, heading])
     corners = np.empty((len(bounds), 2, 2))
     corners[:, :, 0] = np.clip(bounds[:, 0::2], index.low, index.high) + (strip * index.width + index.shift)[:, None]
     corners[:, :, 1] = bounds[:, 1::2]
@@ -106,8 +107,10 @@ def near_heading(
     meet = (bounds[:, 0].take(query) <= index.bounds[:, 2].take(item)) & (
         index.bounds[:, 0].take(item) <= bounds[:, 2].take(query)
     )
-    turn = np.abs(np.mod(index.heading.take(item, axis=0) - heading.take(query)[:, None] + np.pi, 2 * np.pi) - np.pi)
-    keep = np.flatnonzero(meet & (index.everywhere[entry] | np.any(turn <= window, axis=1)))
+    angle, near = heading.take(query), index.everywhere.take(entry)
+    for column in index.heading.T:  # a column at a time: numpy reduces slowly along a short axis
+        near |= np.abs(np.mod(column.take(item) - angle + np.pi, 2 * np.pi) - np.pi) <= window
+    keep = np.flatnonzero(meet & near)
     return query[keep] % max(n, 1), item[keep]
 
 

@@ -349,12 +349,15 @@ def _equal_distances(lw: Linework, p, r, pair) -> tuple[np.ndarray, np.ndarray]:
     quads, foot = _distance_pieces(
         lw.polylines, lw.pairs.take(pair, axis=0).T.ravel(), np.tile(p, (2, 1)), np.tile(r, (2, 1))
     )
-    coefficient = np.moveaxis(quads, 2, 0)
-    a, b, c = coefficient[:, :n, :, None] - coefficient[:, n:, None, :]
-    roots = _quadratic_roots(a, b, c)
+    met = _pieces_met(foot)
+    combo = np.flatnonzero(met[:n, :, None] & met[n:, None, :])
+    hit, piece_i, piece_j = combo // 9, combo // 3 % 3, combo % 3
+    flat_quads = quads.reshape(-1, 3)
+    difference = flat_quads.take(hit * 3 + piece_i, axis=0) - flat_quads.take((n + hit) * 3 + piece_j, axis=0)
+    roots = _quadratic_roots(difference[:, 0], difference[:, 1], difference[:, 2])
     flat = np.flatnonzero((roots > 0) & (roots < 1))
     t = roots.reshape(-1)[flat]
-    hit, piece_i, piece_j = flat // 18, flat // 6 % 3, flat // 2 % 3
+    hit, piece_i, piece_j = hit[flat // 2], piece_i[flat // 2], piece_j[flat // 2]
     valid = _in_piece(foot.take(hit, axis=0), piece_i, t) & _in_piece(foot.take(n + hit, axis=0), piece_j, t)
     hit, piece_i, t = hit[valid], piece_i[valid], t[valid]
     quad = quads.reshape(-1, 3).take(hit * 3 + piece_i, axis=0)
@@ -369,6 +372,21 @@ def _equal_distances(lw: Linework, p, r, pair) -> tuple[np.ndarray, np.ndarray]:
 
 def _wrap(angle: np.ndarray) -> np.ndarray:
     return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+def _pieces_met(s: np.ndarray) -> np.ndarray:
+    """Per row of foot parameters (s0, s1), whether s0 + s1 t may lie in each distance piece's
+    range for some t in [0, 1] (rows of 3 booleans; a superset of where :func:`_in_piece` holds, by
+    a margin far above the rounding of s0 + s1 t; NaN rows meet every piece): only those pieces'
+    pairs are solved."""
+    s0, s1 = s[:, 0], s[:, 1]
+    end = s0 + s1
+    margin = 1e-12 * (np.abs(s0) + np.abs(s1))
+    low, high = np.minimum(s0, end) - margin, np.maximum(s0, end) + margin
+    met = np.empty((len(s), 3), dtype=bool)
+    for piece, (piece_low, piece_high) in enumerate(PIECE_RANGE):
+        met[:, piece] = ~((high < piece_low) | (low > piece_high))
+    return met
 
 
 def _in_piece(s: np.ndarray, piece: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -109,9 +109,17 @@ def near_heading(
     )
     angle, near = heading.take(query), index.everywhere.take(entry)
     for column in index.heading.T:  # a column at a time: numpy reduces slowly along a short axis
-        near |= np.abs(np.mod(column.take(item) - angle + np.pi, 2 * np.pi) - np.pi) <= window
+        near |= np.abs(_wrapped(column.take(item) - angle + np.pi) - np.pi) <= window
     keep = np.flatnonzero(meet & near)
     return query[keep] % max(n, 1), item[keep]
+
+
+def _wrapped(angle: np.ndarray) -> np.ndarray:
+    """``np.mod(angle, 2 * np.pi)``, bit for bit (in place): the angles already in [0, 2π) are
+    their own remainder (0 is not: -0.0 gives 0.0), so only the others (a few) are divided."""
+    outside = np.flatnonzero(~((angle > 0) & (angle < 2 * np.pi)))
+    angle[outside] = np.mod(angle[outside], 2 * np.pi)
+    return angle
 
 
 def _bin(angle: np.ndarray) -> np.ndarray:

@@ -308,7 +308,9 @@ def preimages(
     while len(b.row):
         last = b.left == 1
         moved = _candidates(inv, ex, ey, b, ~last | check_first)
-        if domain is not None:
+        if domain is not None and not (check_first and not moved.left.any()):
+            # not when every branch has reached its start and check_first: _clipped below drops
+            # each sub-interval whose swept segment misses the domain, so every one this would drop
             moved = moved.take(np.flatnonzero(_may_start(ex, ey, moved.branches, domain)))
         if check_first:
             moved = _consistent(geometry, field, lw, ex, ey, moved)

@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 
 from scenegrep.scene import follow_pieces
 from scenegrep.scene.follow_inverse import preimages
-from scenegrep.scene.follow_pieces import ONLY_RAD, _equal_distances, _segment_crossings, _wrap
-from scenegrep.scene.heading_index import WINDOW_RAD, heading_index, near_heading
+from scenegrep.scene.follow_pieces import ONLY_RAD, _equal_distances, _in_piece, _pieces_met, _segment_crossings, _wrap
+from scenegrep.scene.heading_index import WINDOW_RAD, _wrapped, heading_index, near_heading
 from tests.scene.test_follow import FIELD
 from tests.scene.test_follow_start import town01_walks
 
@@ -94,3 +94,34 @@ def test_town01_preimages_equal_those_of_the_r_tree_step(monkeypatch):
     old = [rows(preimages(geometry, FIELD, ex, ey, lo, hi, check)) for check in (True, False)]
     assert new == old
     assert len(new[0]) >= len(x)
+
+
+def test_the_heading_wrap_is_np_mod_bit_for_bit():
+    """The lookup's wrap divides only the angles outside (0, 2π): it must give np.mod's every bit
+    (signed zeros, the ends of the range, NaN and infinities included)."""
+    rng = np.random.default_rng(5)
+    edges = [0.0, -0.0, 2 * np.pi, np.nextafter(2 * np.pi, 0), -1e-300, 1e-300, np.pi, 4 * np.pi, -2 * np.pi]
+    angle = np.concatenate([rng.uniform(-20, 20, 20000), rng.uniform(0, 2 * np.pi, 20000), edges, [np.inf, np.nan]])
+    with np.errstate(invalid="ignore"):
+        expected, found = np.mod(angle, 2 * np.pi), _wrapped(angle.copy())
+    assert np.array_equal(np.isnan(found), np.isnan(expected))
+    same = ~np.isnan(expected)
+    assert np.array_equal(found[same].view(np.int64), expected[same].view(np.int64))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.floats(-1e3, 1e3, allow_subnormal=False),
+    st.floats(-1e3, 1e3, allow_subnormal=False),
+    st.floats(0, 1, exclude_min=True, exclude_max=True),
+)
+def test_the_pieces_a_foot_may_reach_cover_every_root_kept(s0, s1, t):
+    """A pair of distance pieces is solved only where both feet may reach them
+    (:func:`~scenegrep.scene.follow_pieces._pieces_met`): every piece in which the foot s0 + s1 t
+    lies for a t in (0, 1), as :func:`~scenegrep.scene.follow_pieces._in_piece` tests it, is met
+    (feet near the pieces' ends included)."""
+    foot = np.array([[s0, s1], [-1e-9 - s1 * t, s1], [1 + 1e-9 - s1 * t, s1]])
+    met = _pieces_met(foot)
+    for piece in range(3):
+        inside = _in_piece(foot, np.full(3, piece), np.full(3, t))
+        assert not np.any(inside & ~met[:, piece])

@@ -246,7 +246,7 @@ def _inside(ex, ey, pre: Preimage, lines, domain: shapely.Geometry):
     hit = np.flatnonzero(~shapely.is_empty(inside))
     if not len(hit):
         return np.zeros(0), np.zeros(0), np.zeros(0)
-    first = np.array([shapely.get_geometry(g, 0) if shapely.get_num_geometries(g) > 0 else g for g in inside[hit]])
+    first = shapely.get_geometry(inside[hit], 0)  # a collection's first part; any other non-empty geometry itself
     line = shapely.get_type_id(first) == 1
     first[line] = shapely.line_interpolate_point(first[line], 0.5, normalized=True)
     middle = shapely.get_coordinates(first)

@@ -598,6 +598,8 @@ class MapGeometry:
         held = first < len(flat)
         lane[point[held]] = flat[starts[area[held]] + first[held]]
         point, area = point[~held], area[~held]
+        if not len(point):
+            return
         counts = starts[area + 1] - starts[area]
         group = np.repeat(np.arange(len(point)), counts)
         position = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)

@@ -426,10 +426,10 @@ BOX_TYPES = frozenset(name for name in (*_DECODERS, SCENE_UPDATE) if not name.st
 """The message types that give boxes."""
 
 LINK_TYPES = frozenset({"tf2_msgs/TFMessage", "nav_msgs/Odometry"})
+"""The message types that give frame links."""
 
 IMAGE_TYPES = frozenset({"vision_msgs/Detection2DArray"})
 """The box types whose boxes are in an image (the others give 3-D boxes)."""
-"""The message types that give frame links."""
 
 
 def type_key(schema_name: str) -> str:

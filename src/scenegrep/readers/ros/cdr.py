@@ -188,6 +188,13 @@ class _Walker:
         self._plain[type_name] = result
         return result
 
+    def element(self, type_name: str) -> tuple[int, int] | None:
+        """(size, alignment) of an array element of ``type_name``: a primitive's size twice, a
+        plain struct's (:meth:`plain`); None for a string or another struct."""
+        if type_name in PRIMITIVE_SIZES:
+            return (PRIMITIVE_SIZES[type_name],) * 2
+        return None if type_name in STRINGS else self.plain(type_name)
+
     def _strings(self, owner: np.ndarray, pos: np.ndarray, want: bool, what: str) -> tuple[np.ndarray, list]:
         n, pos = self._count(owner, pos, what, 0)
         texts: list[str] = []
@@ -252,8 +259,7 @@ class _Walker:
     def sequence(self, f: Field, full: str, want: bool, owner, items, pos) -> np.ndarray:
         """A fixed array of strings or structs, or a sequence: primitives and plain structs not
         wanted are skipped at once; other elements are walked as the items of level ``full``."""
-        element = PRIMITIVE_SIZES.get(f.type) or (None if f.type in STRINGS else self.plain(f.type))
-        element = (element, element) if isinstance(element, int) else element
+        element = self.element(f.type)
         if f.count == -1:
             n, pos = self._count(owner, pos, full, element[0] if element else 1)
         else:

@@ -135,8 +135,7 @@ def layout(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozense
                 else:
                     pos = walk(f.type, level, path + ".", item, pos)
             else:
-                element = PRIMITIVE_SIZES.get(f.type) or (None if f.type in STRINGS else plainer.plain(f.type))
-                element = (element, element) if isinstance(element, int) else element
+                element = plainer.element(f.type)
                 n, pos = count(pos, element[0] if element else 1) if f.count == -1 else (f.count, pos)
                 if element is not None and not want:
                     pos = (((pos + element[1] - 1) & -element[1]) if n else pos) + n * element[0]

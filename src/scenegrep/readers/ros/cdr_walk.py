@@ -79,8 +79,7 @@ def program(types: dict[str, tuple[Field, ...]], type_name: str, wanted: frozens
                 else:
                     struct(f.type, level, path + ".", depth + 1)
             else:
-                element = PRIMITIVE_SIZES.get(f.type) or (None if f.type in STRINGS else plainer.plain(f.type))
-                element = (element, element) if isinstance(element, int) else element
+                element = plainer.element(f.type)
                 fixed = -1 if f.count == -1 else f.count
                 if element is not None and not want:
                     rows.append([SEQ_SKIP, element[0], element[1], fixed, 0, 0])

@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 from typing import Any
 
+from ..errors import UserError
 from .exit_codes import EXIT_SOME_FAILED
 from ..wording import counted
 from .options import add_jobs_argument, add_map_argument, add_unknown_layers_argument, report_unknown_layers
@@ -50,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
     from ..dataset.ingest import ingest
     from ..progress import bar as progress_bar
 
+    _check_dataset_folder(args.into)
     with progress_bar(quiet=args.quiet, unit="source", leave=False) as bar:
         report = ingest(
             args.sources,
@@ -73,3 +76,15 @@ def run(args: argparse.Namespace) -> int:
 
     report_unknown_layers(UnknownLayers(args.unknown_layers, report.assumed))
     return EXIT_SOME_FAILED if report.failed else 0
+
+
+def _check_dataset_folder(into: str) -> None:
+    """UserError, before anything is made, for a dataset directory that cannot be one: an empty or
+    blank name (not the working directory by accident), or a path that is a file or lies under one."""
+    if not into.strip():
+        raise UserError("-o: give the dataset directory")
+    path = Path(into)
+    existing = next((folder for folder in (path, *path.parents) if folder.exists()), None)
+    if existing is not None and not existing.is_dir():
+        below = "" if existing == path else f" ({existing} is a file)"
+        raise UserError(f"-o {into}: not a directory{below}; a dataset is a directory")

@@ -131,8 +131,8 @@ class _Segment:
 class _Rows:
     """The rows of one trace as its frames are emitted (the offline run's whole bag, or one
     chunk of :meth:`FrameBuilder.feed`): the state columns, growing (:class:`.columns.Column`;
-    rows in (frame, object) order, frames numbered from 0), the frames' ``stamps`` (ns) and
-    ``times`` (s from the origin), their images, and the objects numbered in order of first
+    rows in (frame, object) order, frames numbered from 0), the frames' ``times`` (s from the
+    origin), their images, and the objects numbered in order of first
     appearance: ``number`` (per builder code of an object id; -1 not yet seen), ``objects`` (the
     codes in number order) and ``category`` (the class code of each at its first row)."""
 
@@ -145,7 +145,6 @@ class _Rows:
         self.number = np.full(max(codes, 1), -1, dtype=np.int32)
         self.objects: list[int] = []
         self.category: list[int] = []
-        self.stamps: list[np.ndarray] = []
         self.times: list[np.ndarray] = []
         self.images: list[tuple[ImageLayer | None, int]] = []
         self.has_ego: bool | None = None
@@ -414,7 +413,6 @@ class FrameBuilder:
         out.object.rows(start, stop)[:] = kept_numbers
         out.size = stop
         out.images.append((images, out.frames))
-        out.stamps.append(stamps)
         out.times.append((stamps - self.origin) / 1e9)
         out.frames += len(stamps)
         out.has_ego = has_ego if out.has_ego is None else out.has_ego

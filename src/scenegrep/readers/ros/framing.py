@@ -101,12 +101,11 @@ class _Names:
 
 @dataclass
 class _Segment:
-    """The boxes of one decoded batch of one topic, its messages' stamps and log times, and (3-D
-    boxes) the builder's codes (int32) of every row's object id, class and frame id."""
+    """The boxes of one decoded batch of one topic, its messages' log times, and (3-D boxes) the
+    builder's codes (int32) of every row's object id, class and frame id."""
 
     topic: str
     boxes: Boxes | ImageBoxes
-    stamps: np.ndarray
     log_times: np.ndarray
     ids: np.ndarray | None = None
     classes: np.ndarray | None = None
@@ -117,6 +116,11 @@ class _Segment:
 
     def __post_init__(self) -> None:
         self.alive = np.ones(len(self.stamps), dtype=bool)
+
+    @property
+    def stamps(self) -> np.ndarray:
+        """The header stamp of every message (ns)."""
+        return self.boxes.message_stamps
 
     def rows(self, messages: np.ndarray) -> np.ndarray | slice:
         """The rows of the boxes of ``messages`` (positions, each once): a boolean mask, or every
@@ -236,7 +240,7 @@ class FrameBuilder:
             self.frame_topic = topic
         if self.origin is None and self.options.rate is not None:
             self.origin = int(boxes.message_stamps.min())
-        segment = _Segment(topic, boxes, boxes.message_stamps, log_times)
+        segment = _Segment(topic, boxes, log_times)
         if isinstance(boxes, Boxes):
             segment.ids, objects = self.ids.codes(boxes.id)
             segment.objects = np.unique(objects)

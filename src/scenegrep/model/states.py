@@ -66,30 +66,21 @@ class StateTable(RowTable):
     def sort_order(self) -> np.ndarray | None:
         """The permutation that orders rows by (frame, object), or None when already ordered."""
         objects = int(self.object.max(initial=0)) + 1
-        return None if self.in_order(objects) else np.argsort(self.row_keys(objects), kind="stable")
+        return (
+            None if self.in_order(objects) else np.argsort(order_keys(self.frame, self.object, objects), kind="stable")
+        )
 
     def in_order(self, objects: int) -> bool:
         """Whether the rows are in (frame, object) order without repeats (``objects`` above every
-        object code): :meth:`row_keys` strictly increasing, checked in blocks of :data:`BLOCK`
+        object code): :func:`order_keys` strictly increasing, checked in blocks of :data:`BLOCK`
         rows (no array of the table's length is made)."""
         n = len(self.frame)
         for start in range(0, n - 1, BLOCK):
             stop = min(start + BLOCK + 1, n)  # (one row of overlap with the next block)
-            key = self.frame[start:stop].astype(np.int64)
-            key *= objects
-            key += self.object[start:stop]
+            key = order_keys(self.frame[start:stop], self.object[start:stop], objects)
             if not (key[1:] > key[:-1]).all():
                 return False
         return True
-
-    def row_keys(self, objects: int) -> np.ndarray:
-        """``frame * objects + object`` of every row as int64 (increasing along the rows exactly when
-        they are in (frame, object) order without repeats, for ``objects`` above every object code);
-        made in one array (the table may have millions of rows)."""
-        key = self.frame.astype(np.int64)
-        key *= objects
-        key += self.object
-        return key
 
     def speed(self) -> np.ndarray:
         """Speed in m/s from the velocity columns (NaN where unknown)."""
@@ -98,3 +89,12 @@ class StateTable(RowTable):
     def frame_offsets(self, n_frames: int) -> np.ndarray:
         """CSR offsets: rows of frame f are ``offsets[f]:offsets[f + 1]`` (length n_frames + 1)."""
         return np.searchsorted(self.frame, np.arange(n_frames + 1), side="left")
+
+
+def order_keys(frame: np.ndarray, object: np.ndarray, objects: int) -> np.ndarray:
+    """``frame * objects + object`` of rows as a new int64 array: increasing along the rows exactly
+    when they are in (frame, object) order without repeats, for ``objects`` above every object code."""
+    key = frame.astype(np.int64)
+    key *= objects
+    key += object
+    return key

@@ -54,7 +54,7 @@ from ...errors import UserError
 from ...model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable, StateTable, TraceSource
 from ...model.geometry import heading_from_atan2, heading_from_yaw
 from ...model.images import concatenate_layers
-from ...model.states import FLOAT_COLUMNS
+from ...model.states import FLOAT_COLUMNS, order_keys
 from ...model.trace import EGO_SIZE_UNKNOWN
 from .decoders import BOX_TYPES, LINK_TYPES, type_key
 from .messages import Boxes, Coded, ImageBoxes, RawMessage
@@ -443,9 +443,7 @@ class FrameBuilder:
             out.category += np.concatenate(classes)[first].tolist()
         kept_frames = frame if by_frame is None else frame[by_frame]
         kept_numbers = number[ids if by_frame is None else ids[by_frame]]
-        key = kept_frames.astype(np.int64)
-        key *= max(len(out.objects), 1)
-        key += kept_numbers
+        key = order_keys(kept_frames, kept_numbers, max(len(out.objects), 1))
         kept = by_frame
         if not (key[1:] > key[:-1]).all():  # an object twice in a frame, or objects out of order
             order = np.argsort(key, kind="stable")

@@ -51,7 +51,8 @@ _DATA = itemgetter(6)
 @dataclass(frozen=True)
 class Segment:
     """The messages of one topic in a batch: their ``log_times`` (ns, int64, in order) and what
-    they decode to (``decoded``; None for a topic of an unsupported type, not decoded)."""
+    they decode to (``decoded``; None for a topic of an unsupported type, not decoded: its
+    ``log_times`` then empty, as nothing reads them)."""
 
     topic: str
     schema_name: str

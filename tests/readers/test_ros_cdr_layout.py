@@ -22,7 +22,8 @@ from scenegrep import readers
 from scenegrep.errors import UserError
 from scenegrep.readers.ros.cdr import Payloads, decode
 from scenegrep.readers.ros import _cdr_copy
-from scenegrep.readers.ros.cdr_layout import Unsupported, decode_same_layout, layout
+from scenegrep.readers.ros.cdr_batch import CdrBatch
+from scenegrep.readers.ros.cdr_layout import Unsupported, layout
 from scenegrep.readers.ros.chunks import mcap_messages
 from scenegrep.readers.ros.decoders import _DECODERS, decode_batch, type_key, types_of
 from scenegrep.readers.ros.messages import Coded
@@ -90,12 +91,21 @@ def test_batches_read_in_place_decode_as_the_generic_walk(pool, picks, frame, co
     cache = {}
     if stale and len(pool) > 1:
         cache["k"] = layout(TYPES, KEY, WANTED, _message(pool[1], 0, frame)[4:])
-    levels = decode_same_layout(TYPES, KEY, WANTED, payloads, cache, "k")
+    levels = _one_layout(payloads, cache)
     slow = BUILD(decode(TYPES, KEY, Payloads.of([bytes(p) for p in payloads]), WANTED))
     assert (levels is not None) == all(_shape(o) == _shape(chosen[0]) for o in chosen)
     if levels is not None:
         _same_boxes(BUILD(levels), slow)
     _same_boxes(decode_batch([m for m in found if m.topic == TOPIC]), slow)
+
+
+def _one_layout(payloads: list, cache: dict):
+    """The levels of a batch decoded as one layout (a :class:`CdrBatch` without the C walk, its
+    layout ``cache["k"]``'s when the first message is of it, else the first message's), or None
+    when not every message was copied on that layout."""
+    batch = CdrBatch(TYPES, KEY, WANTED, "k", len(payloads), cache, None)
+    batch.add(payloads)
+    return batch.levels() if batch.mode == "layout" else None
 
 
 def _equal_sizes() -> tuple[list[dict], list[dict]]:
@@ -116,7 +126,7 @@ def test_equal_sizes_with_other_counts_are_not_one_layout():
     a, b = _equal_sizes()
     raw = [_message(a, 1, "map"), _message(b, 2, "map")]
     assert len(raw[0]) == len(raw[1])
-    assert decode_same_layout(TYPES, KEY, WANTED, [memoryview(r) for r in raw], {}, "k") is None
+    assert _one_layout([memoryview(r) for r in raw], {}) is None
     slow = BUILD(decode(TYPES, KEY, Payloads.of(raw), WANTED))
     _same_boxes(decode_batch([_raw(r, i) for i, r in enumerate(raw)]), slow)
 

@@ -5,28 +5,28 @@ once) and notes the byte offset of every wanted primitive and string and of ever
 sequence's length, a string's length). Two messages of one type whose sizes are equal and whose
 counts are equal at those offsets have the same layout: each offset depends only on the counts
 before it, and every bound the generic walk checks (a read past the end, a count too large for
-the bytes left) depends only on the counts and the size. :func:`decode_same_layout` checks
-exactly that for every message, and copies every wanted field of every message into its column,
+the bytes left) depends only on the counts and the size. :func:`copy` checks exactly that for
+every message, and copies every wanted field of every message into its column (:func:`columns`),
 in one pass of C per chunk (:mod:`._cdr_copy`) over a plan made once per layout (what to
 compare, what to copy where): no Python runs per message, object or field.
 
-A batch that is not of one layout, or holds a bad header, or a type this module does not walk
-(a wanted sequence of strings or primitives) gives None: the caller decodes it with
-:func:`.cdr.decode`, which also names a bad message. The levels returned are those
-:func:`.cdr.decode` gives, items in message order.
+:func:`copy` stops at a message of another layout (or a bad header), and :func:`layout` refuses
+a type this module does not walk (a wanted sequence of strings or primitives) or a malformed
+message (:class:`Unsupported`): the caller (:mod:`.cdr_batch`) decodes those otherwise. The
+levels of the rows copied (:func:`levels_of`) are those :func:`.cdr.decode` gives, items in
+message order.
 """
 
 from __future__ import annotations
 
 import struct
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from . import _cdr_copy
-from .buffers import Group, groups
-from .cdr import _DTYPES, HEADER, Level, Payloads, _Walker
+from .buffers import Group
+from .cdr import _DTYPES, Level, Payloads, _Walker
 from .msgdef import PRIMITIVE_SIZES, STRINGS, Field
 
 
@@ -249,42 +249,3 @@ def _items(plan: Layout, name: str, n: int) -> tuple[np.ndarray, np.ndarray]:
         parent.flags.writeable = rank.flags.writeable = False
         found = plan.items[name] = (n, parent, rank)
     return found[1], found[2]
-
-
-def decode_groups(plan: Layout, groups: list[Group]) -> dict[str, Level] | None:
-    """The levels of the messages of ``groups`` (all of the plan's size) in message order, or
-    None when one of them is not of layout ``plan`` (another count, or a bad header)."""
-    n = sum(len(g.origins) for g in groups)
-    out = columns(plan, n)
-    start = 0
-    for g in groups:
-        if copy(plan, g, out, start) < len(g.origins):
-            return None
-        start += len(g.origins)
-    return levels_of(plan, out, n)
-
-
-def decode_same_layout(
-    types: dict[str, tuple[Field, ...]],
-    type_name: str,
-    wanted: frozenset[str],
-    payloads: Sequence,
-    cache: dict[object, Layout],
-    key: object,
-) -> dict[str, Level] | None:
-    """The levels of a batch of one layout (that of ``cache[key]``, else of its first message,
-    then kept there), or None when the batch is not of one layout (see the module docstring).
-    ``payloads``: each message's bytes or a memoryview into its chunk (read in place)."""
-    found = groups(payloads)
-    size = found[0].sizes[0]
-    if size < 0 or any((g.sizes != size).any() for g in found):
-        return None
-    plan = cache.get(key)
-    levels = decode_groups(plan, found) if plan is not None and plan.size == size else None
-    if levels is None:
-        try:
-            plan = cache[key] = layout(types, type_name, wanted, bytes(payloads[0][HEADER:]))
-        except Unsupported:
-            return None
-        levels = decode_groups(plan, found)
-    return levels

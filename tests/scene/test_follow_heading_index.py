@@ -64,7 +64,7 @@ def reference_crossings(lw, px, py, qx, qy, only=None):
     only = np.asarray(only)[index]
     segments = shapely.linestrings(np.stack([p, p + r], axis=1))
     walk, line = lw.tree.query(segments)
-    side = lw.side[line]
+    side = lw.heading_items.heading[line]  # the lines' headings either side, as the linework filed them
     mine = np.isnan(side[:, 0]) | np.any(np.abs(_wrap(side - only[walk][:, None])) <= ONLY_RAD, axis=1)
     walk, line = walk[mine], line[mine]
     hit, t = _segment_crossings(p[walk], r[walk], lw.start[line], lw.end[line] - lw.start[line])

@@ -85,28 +85,25 @@ interior, to the end vertex), with slack."""
 
 @dataclass
 class Linework:
-    """Where ``roadDirection`` may change (see the module docstring): segments with an R-tree (and,
-    for the lines at a centreline's vertex, the headings of the segments either side, between
-    which alone the heading may change there; NaN for area boundaries), and
-    pairs of centreline segments of one lane that may compete for a point, with an
-    R-tree of the boxes where they may (within the lane's reach of both); the centreline segments
-    as lines; an R-tree of where a lane's direction may count at all (each lane grown by Scenic's
-    tolerance, and the intersection areas, where the nearest lane may count). For cuts for one
-    heading (:func:`crossings` with ``only``): the lines and the pairs in one heading index (items
-    0 .. len(start) - 1 the lines: the area boundaries for every heading, the vertex lines by the
-    headings either side; then the pairs, by their two segments' headings), so that one lookup
-    finds all three."""
+    """Where ``roadDirection`` may change (see the module docstring): segments with an R-tree, and
+    pairs of centreline segments of one lane that may compete for a point (``pair_lane``: their
+    lane; ``pair_reach``: its reach plus the margin), with an R-tree of the boxes where they may
+    (within the lane's reach of both); the centreline polylines; an R-tree of where a lane's
+    direction may count at all (each lane grown by Scenic's tolerance, and the intersection areas,
+    where the nearest lane may count). For cuts for one heading (:func:`crossings` with ``only``):
+    the lines and the pairs in one heading index (items 0 .. len(start) - 1 the lines: the area
+    boundaries for every heading, the vertex lines by the headings of the segments either side,
+    between which alone the heading may change there; then the pairs, by their two segments'
+    headings), so that one lookup finds all three."""
 
     start: np.ndarray
     end: np.ndarray
-    side: np.ndarray
     tree: shapely.STRtree
     pairs: np.ndarray
     pair_lane: np.ndarray
     pair_reach: np.ndarray
     pair_tree: shapely.STRtree
     polylines: Polylines
-    segments: np.ndarray
     lane_reach: shapely.STRtree
     heading_items: HeadingIndex
 
@@ -178,7 +175,6 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     tree = shapely.STRtree(shapely.linestrings(np.stack([start, end], axis=1)))
     pairs, lanes, boxes = _competing_pairs(polylines, reach)
     near = reach[lanes] + REACH_MARGIN_M
-    segments = shapely.linestrings(np.stack([polylines.start, polylines.end], axis=1))
     lane_reach = shapely.STRtree(np.append(shapely.buffer(road_map.lane_polygons, ELEMENT_REACH_M), intersections))
     heading_items = heading_index(
         np.concatenate([side, polylines.heading[pairs].reshape(-1, 2)]),
@@ -188,14 +184,12 @@ def _build_linework(geometry: MapGeometry) -> Linework:
     return Linework(
         start,
         end,
-        side,
         tree,
         pairs,
         lanes,
         near,
         shapely.STRtree(boxes),
         polylines,
-        segments,
         lane_reach,
         heading_items,
     )

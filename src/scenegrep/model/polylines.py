@@ -24,8 +24,8 @@ class Polylines:
     def __init__(self, lines: list[np.ndarray] | tuple[np.ndarray, ...]):
         cleaned = [_without_repeats(np.asarray(line, dtype=np.float64)[:, :2]) for line in lines]
         self.lines = cleaned
-        counts = np.array([max(len(line) - 1, 0) for line in cleaned], dtype=np.intp)
-        self.first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.intp) if len(counts) else counts
+        counts = np.array([max(len(line) - 1, 0) for line in cleaned], dtype=np.int64)
+        self.first = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64) if len(counts) else counts
         self.count = counts
         self.last = self.first + np.maximum(counts - 1, 0)
         starts = [line[:-1] for line in cleaned if len(line) > 1]
@@ -42,8 +42,6 @@ class Polylines:
         self.local_end = np.concatenate(
             [np.cumsum(lengths[f : f + c]) for f, c in zip(self.first.tolist(), counts.tolist())] or [np.zeros(0)]
         )
-        self.first64 = np.ascontiguousarray(self.first, dtype=np.int64)
-        self.count64 = np.ascontiguousarray(self.count, dtype=np.int64)
 
     @cached_property
     def geometries(self) -> np.ndarray:
@@ -64,8 +62,8 @@ class Polylines:
         locate(
             self.start,
             self.end,
-            self.first64,
-            self.count64,
+            self.first,
+            self.count,
             line,
             np.ascontiguousarray(x, dtype=np.float64),
             np.ascontiguousarray(y, dtype=np.float64),

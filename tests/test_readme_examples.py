@@ -150,19 +150,21 @@ def written(command: Command) -> set[str]:
 
 def groups(found: list[Command]) -> list[list[Command]]:
     """``found`` in groups, each in README order: a command joins every earlier group that writes a
-    path whose first component it names (or writes itself), so no group reads or overwrites what
-    another writes. The groups come largest first (the long tests start first)."""
+    path whose first component it names, or names a path it writes, so no group reads or overwrites
+    what another writes. The groups come largest first (the long tests start first)."""
     members: list[list[Command]] = []
     writes: list[set[str]] = []
+    names: list[set[str]] = []
     for command in found:
-        named = {_top(word) for word in _words(command)}
-        joined = [k for k, wrote in enumerate(writes) if wrote & named]
-        group, wrote = [command], written(command)
+        group, wrote, named = [command], written(command), {_top(word) for word in _words(command)}
+        joined = [k for k in range(len(members)) if writes[k] & named or names[k] & wrote]
         for k in reversed(joined):
             group = members.pop(k) + group
             wrote |= writes.pop(k)
+            named |= names.pop(k)
         members.append(group)
         writes.append(wrote)
+        names.append(named)
     members = [sorted(group, key=lambda c: c.line) for group in members]
     return sorted(members, key=lambda group: (-len(group), group[0].line))
 
@@ -270,8 +272,16 @@ def test_groups_share_no_written_path():
     assert len(GROUPS) > 5
     for k, group in enumerate(GROUPS):
         wrote = set().union(*map(written, group))
-        for other in GROUPS[k + 1 :]:
+        for other in GROUPS[:k] + GROUPS[k + 1 :]:
             assert not wrote & {_top(word) for c in other for word in _words(c)}, (group[0].line, other[0].line)
+
+
+def test_a_command_joins_the_group_that_reads_what_it_writes():
+    """A later writer of what an earlier command read runs after it, in its group (else a group
+    run first could change what the other reads)."""
+    found = [Command("scenegrep info a.parquet", 1), Command("scenegrep info b.parquet", 2)]
+    found.append(Command("scenegrep spre x b.parquet -o a.parquet", 3))
+    assert [[c.line for c in group] for group in groups(found)] == [[1, 3], [2]]
 
 
 @pytest.mark.slow

@@ -69,3 +69,13 @@ def test_results_without_times_are_no_foxglove_events(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("scenegrep: error: match 0 of stream: the trace gives no time") and err.count("\n") == 1
     assert not (tmp_path / "m.mcap").exists()
+
+
+@pytest.mark.parametrize("argv", [["-o", "adir", "--format", "mcap"], ["--mcap", "adir"]])
+def test_an_existing_folder_is_no_mcap_file(results, tmp_path, monkeypatch, capsys, argv):
+    """A relative OUT that is a folder: one line naming it, not the temporary file beside it."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "adir").mkdir()
+    assert export(results, *argv) == 2
+    assert capsys.readouterr().err == "scenegrep: error: adir: cannot write: Is a directory\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["adir"] and not any((tmp_path / "adir").iterdir())

@@ -35,11 +35,14 @@ def atomic_path(target: str | Path) -> Iterator[Path]:
 
 @contextlib.contextmanager
 def _writing(target: Path) -> Iterator[None]:
-    """Turn an OSError raised while writing ``target`` into a :class:`UserError`."""
+    """Turn an OSError raised while writing ``target`` into a :class:`UserError`; the file it names
+    is said unless it lies beside ``target`` (the temporary file, or ``target`` itself), however
+    either path is written (relative or absolute)."""
     try:
         yield
     except OSError as exc:
-        other = f" ({exc.filename})" if exc.filename and Path(exc.filename).parent != target.parent else ""
+        beside = exc.filename and Path(os.path.abspath(exc.filename)).parent == Path(os.path.abspath(target)).parent
+        other = f" ({exc.filename})" if exc.filename and not beside else ""
         raise UserError(f"cannot write: {exc.strerror or first_line(exc)}{other}", at(target)) from None
 
 

@@ -52,6 +52,9 @@ def test_a_folder_takes_its_kind_from_format(results, tmp_path, capsys):
         (["-o", "{tmp}/a.mcap", "--format", "xosc"], "invalid choice: 'xosc' (choose from 'mcap', 'refav'"),
         ([], "one of the arguments -o/--output --mcap --refav --openscenario --scenic is required"),
         (["-o", "{results}", "--format", "scenic"], "-o {results}: not a directory"),
+        (["-o", "", "--format", "mcap"], "-o: give the file to write to"),
+        (["--mcap", " "], "--mcap: give the file to write to"),
+        (["--refav", "", "--prompt", "p"], "--refav: give the file to write to"),
     ],
 )
 def test_one_line_errors(results, tmp_path, capsys, argv, message):

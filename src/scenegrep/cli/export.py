@@ -104,6 +104,9 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--format goes with -o/--output (or write --{args.format} OUT)")
     if args.output is not None:
         setattr(args, output_kind(args.output, args.format), args.output)
+    for kind in ("mcap", "refav"):
+        if getattr(args, kind) is not None and not getattr(args, kind).strip():
+            raise UserError(f"{_option(args, '--' + kind)}: give the file to write to")
     if args.context is not None and args.openscenario is None and args.scenic is None:
         raise UserError("--context goes with --openscenario or --scenic")
     if args.scenic is not None:

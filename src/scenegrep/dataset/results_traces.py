@@ -61,10 +61,7 @@ class ResultsTraces:
         one given, else the one the file lies in, else none (a query over files). UserError for a
         file that is no results table."""
         results = Results.read(path)
-        root = Path(dataset).resolve() if dataset is not None else find_dataset(path)
-        if root is None:
-            return cls(results, None, recorded_query(results.query))
-        return cls.of_run(root, results)
+        return cls.of_results(results, Path(dataset).resolve() if dataset is not None else find_dataset(path))
 
     @classmethod
     def of_results(cls, results: Results, dataset: Path | None) -> Self:

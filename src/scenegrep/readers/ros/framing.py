@@ -140,13 +140,13 @@ class _Rows:
     appearance: ``number`` (per builder code of an object id; -1 not yet seen), ``objects`` (the
     codes in number order) and ``category`` (the class code of each at its first row)."""
 
-    def __init__(self, codes: int) -> None:
+    def __init__(self) -> None:
         self.frame = Column(np.int32)
         self.object = Column(np.int32)
         self.values = [Column(np.float64) for _ in FLOAT_COLUMNS]
         self.size = 0
         self.frames = 0
-        self.number = np.full(max(codes, 1), -1, dtype=np.int32)
+        self.number = np.empty(0, dtype=np.int32)
         self.objects: list[int] = []
         self.category: list[int] = []
         self.times: list[np.ndarray] = []
@@ -191,13 +191,13 @@ class FrameBuilder:
     def feed(self, batch: Sequence[RawMessage]) -> LabelTrace | None:
         """Take a batch of messages (decoded by :func:`.segments.segments`); the frames it
         completed, or None."""
-        rows = _Rows(len(self.ids))
+        rows = _Rows()
         self._feed(segments(batch, self.options), rows)
         return self._trace(rows)
 
     def finish(self) -> LabelTrace | None:
         """The frames left at the end of input; notes unknown topics and late messages on stderr."""
-        rows = _Rows(len(self.ids))
+        rows = _Rows()
         self._finish(rows)
         return self._trace(rows)
 
@@ -206,7 +206,7 @@ class FrameBuilder:
         frames as one trace (the chunks :meth:`feed` and :meth:`finish` would give, concatenated),
         or None when no frame was built. The frames' rows are written into one set of growing
         columns; the trace is made once, at the end."""
-        rows = _Rows(len(self.ids))
+        rows = _Rows()
         for batch in batches:
             self._feed(batch, rows)
         self._finish(rows)

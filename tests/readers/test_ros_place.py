@@ -46,7 +46,7 @@ def _reference(b: dict[str, np.ndarray]) -> np.ndarray:
     rotation = np.where(moved, np.array(product(t, b["quat"].T)), b["quat"].T)
     x, y, z, w = rotation
     sine, cosine = _sum((w, z, 1), (x, y, 1)) * 2.0, 1.0 - _sum((y, y, 1), (z, z, 1)) * 2.0
-    velocity = rotated(rotation, b["velocity"].T, axes=2)
+    velocity = rotated(rotation, b["velocity"].T)[:2]
     return np.vstack([position, sine, b["size"].T, velocity, cosine])
 
 

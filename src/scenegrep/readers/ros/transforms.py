@@ -58,9 +58,9 @@ def product(a: Components, b: Components) -> tuple[np.ndarray, ...]:
     )
 
 
-def rotated(q: Components, v: Components, axes: int = 3) -> tuple[np.ndarray, ...]:
-    """The components of vectors ``v`` rotated by unit quaternions ``q``: v + w t + u x t with
-    t = 2 (u x v), for q = (u, w); the first ``axes`` of them (x, y, z)."""
+def rotated(q: Components, v: Components) -> tuple[np.ndarray, ...]:
+    """The components (x, y, z) of vectors ``v`` rotated by unit quaternions ``q``: v + w t + u x t
+    with t = 2 (u x v), for q = (u, w)."""
     ux, uy, uz, w = q
     vx, vy, vz = v
     tx, ty, tz = _sum((uy, vz, 1), (uz, vy, -1)), _sum((uz, vx, 1), (ux, vz, -1)), _sum((ux, vy, 1), (uy, vx, -1))
@@ -71,7 +71,7 @@ def rotated(q: Components, v: Components, axes: int = 3) -> tuple[np.ndarray, ..
         (vx, tx, ((uy, tz, 1), (uz, ty, -1))),
         (vy, ty, ((uz, tx, 1), (ux, tz, -1))),
         (vz, tz, ((ux, ty, 1), (uy, tx, -1))),
-    )[:axes]:
+    ):
         moved = np.multiply(w, along)
         moved += value
         moved += _sum(*cross)

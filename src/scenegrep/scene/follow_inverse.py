@@ -274,7 +274,7 @@ def _neighbours(lines: Polylines) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     owner = np.repeat(np.arange(len(lines)), lines.count)
     index = np.arange(len(owner))
     first = index == lines.first[owner]
-    last = index == (lines.first + lines.count - 1)[owner]
+    last = index == lines.last[owner]
     before = np.where(first[:, None], np.nan, np.roll(usable, 1, axis=0))
     after = np.where(last[:, None], np.nan, np.roll(usable, -1, axis=0))
     return unit, before, after

@@ -51,8 +51,7 @@ def run_query_command(
         if not args.dataset:  # a dataset run said so before querying (_report_plan)
             _report_pruned(reason for reason in results.with_status("pruned")["explanation"].to_pylist())
         _summary(results, where or (f"; results in {args.output}" if args.output else ""))
-        for warning in results.warnings:
-            print(f"scenegrep: warning: {warning}", file=sys.stderr)
+    print_warnings(results.warnings, args)
     if uses_map(spec):
         report_unknown_layers(UnknownLayers(spec.option("unknown_layers"), Counter(results.assumed)))
         if not counts["matched"]:
@@ -62,6 +61,12 @@ def run_query_command(
     if counts["failed"]:
         return EXIT_SOME_FAILED
     return 0 if counts["matched"] else EXIT_NO_MATCH
+
+
+def print_warnings(warnings: Iterable[str], args: argparse.Namespace) -> None:
+    """Each warning on stderr (``scenegrep: warning: ...``), unless ``-q``."""
+    for warning in [] if args.quiet else warnings:
+        print(f"scenegrep: warning: {warning}", file=sys.stderr)
 
 
 def results_of(

@@ -20,7 +20,7 @@ import argparse
 import sys
 from typing import Any
 
-from .dataset_run import RowPrinter, run_query_command
+from .dataset_run import RowPrinter, print_warnings, run_query_command
 from .exit_codes import EXIT_NO_MATCH
 from .options import (
     add_bag_arguments,
@@ -128,8 +128,7 @@ def _run_online(args: argparse.Namespace) -> int:
         for results in stream.results(live.chunks, announce):
             show(results)
     show(stream.final())
-    for warning in [] if args.quiet else stream.warnings:
-        print(f"scenegrep: warning: {warning}", file=sys.stderr)
+    print_warnings(stream.warnings, args)
     for note in stream.notes:
         print(f"scenegrep: {note}", file=sys.stderr)
     report_unknown_layers(choice)

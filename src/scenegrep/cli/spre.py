@@ -21,7 +21,7 @@ import sys
 from collections.abc import Iterable
 from typing import Any
 
-from .dataset_run import run_query_command
+from .dataset_run import print_warnings, run_query_command
 from .exit_codes import EXIT_NO_MATCH
 from .options import (
     add_bag_arguments,
@@ -93,12 +93,6 @@ def _report(
     return found
 
 
-def _warn(warnings: Iterable[str], args: argparse.Namespace) -> None:
-    """Each warning on stderr, unless ``-q``."""
-    for warning in [] if args.quiet else warnings:
-        print(f"scenegrep: warning: {warning}", file=sys.stderr)
-
-
 def _streams(args: argparse.Namespace) -> bool:
     """Whether the command searches streams as STREM does (``--compat strem``, ``--online``,
     ``--export`` or standard input), printing each file's matches as found and stopping at the
@@ -147,7 +141,7 @@ def _run_streams(args: argparse.Namespace) -> int:
             found |= _run_live(query, args, options, form) == 0
             continue
         for search in input_searches(query, path, options, args.online):
-            _warn(search.warnings, args)
+            print_warnings(search.warnings, args)
             found |= _report(search.matches, path, search.prefix, args, form, search.trace)
     return 0 if found else EXIT_NO_MATCH
 
@@ -162,6 +156,6 @@ def _run_live(query: Any, args: argparse.Namespace, options: Any, form: Any) -> 
     search = LiveSearch(query, open_input(args, iter_documents), options)
     with until_stopped():
         _report(search.matches, search.live.source, search.prefix, args, form)
-    _warn(search.warnings, args)
+    print_warnings(search.warnings, args)
     report(search.live.latency, args)
     return 0 if search.live.latency.found else EXIT_NO_MATCH

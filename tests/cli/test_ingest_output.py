@@ -20,6 +20,7 @@ TRACE = str(REPO / "examples/sample/s3_pass_pedestrian-000.parquet")
         ("  ", "-o: give the dataset directory"),
         ("{tmp}/file", "-o {tmp}/file: not a directory; a dataset is a directory"),
         ("{tmp}/file/ds", "-o {tmp}/file/ds: not a directory ({tmp}/file is a file); a dataset is a directory"),
+        ("{tmp}/" + "d" * 300, "-o {tmp}/" + "d" * 300 + ": File name too long"),
     ],
 )
 def test_one_line_errors(tmp_path, monkeypatch, capsys, into, message):

@@ -80,11 +80,15 @@ def run(args: argparse.Namespace) -> int:
 
 def _check_dataset_folder(into: str) -> None:
     """UserError, before anything is made, for a dataset directory that cannot be one: an empty or
-    blank name (not the working directory by accident), or a path that is a file or lies under one."""
+    blank name (not the working directory by accident), a path that is a file or lies under one, or a
+    name the file system refuses."""
     if not into.strip():
         raise UserError("-o: give the dataset directory")
     path = Path(into)
-    existing = next((folder for folder in (path, *path.parents) if folder.exists()), None)
+    try:
+        existing = next((folder for folder in (path, *path.parents) if folder.exists()), None)
+    except OSError as error:  # (a name the file system refuses, such as one too long)
+        raise UserError(f"-o {into}: {error.strerror}") from None
     if existing is not None and not existing.is_dir():
         below = "" if existing == path else f" ({existing} is a file)"
         raise UserError(f"-o {into}: not a directory{below}; a dataset is a directory")

@@ -122,7 +122,10 @@ class Catalog:
         if path is not None and not create and not path.is_file():
             raise UserError("not a scenegrep dataset (no catalog.duckdb; create one with scenegrep ingest)", at(root))
         if path is not None and create:
-            path.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+            except OSError as error:
+                raise UserError(f"cannot make the dataset directory: {error.strerror}", at(root)) from None
         self.db = _connect(path, read_only)
         if path is not None and not read_only:
             self.db.execute(SCHEMA)

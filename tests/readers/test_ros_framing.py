@@ -13,6 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from scenegrep.errors import UserError
 from scenegrep.model import concatenate
 from scenegrep.model.geometry import heading_difference
 from scenegrep.readers.ros import framing
@@ -162,3 +163,19 @@ def test_a_coded_column_gives_back_its_strings(strings, copies):
     coded = Coded.of(column)
     assert coded.strings().tolist() == strings
     assert coded[np.arange(len(strings))[::-1]].strings().tolist() == strings[::-1]
+
+
+def test_rate_frames_spanning_more_than_a_trace_holds_are_a_user_error():
+    """Boxes stamped 1e18 ns apart at --rate 10000 would be 1e13 frames: a one-line error before
+    any array is sized by them (was: numpy's MemoryError); the frames complete when the second
+    arrives are all but its own."""
+    stamps = np.array([ORIGIN, ORIGIN + 10**18], dtype=np.int64)
+    text = lambda value: np.array([value, value], dtype=object)  # noqa: E731
+    boxes = Boxes(
+        np.arange(2), stamps, text("map"), text("a"), text("car"), np.zeros((2, 3)),
+        np.tile([0.0, 0.0, 0.0, 1.0], (2, 1)), np.ones((2, 3)), np.zeros((2, 3)), stamps,
+    )  # fmt: skip
+    segment = Segment(BOXES, SCHEMAS[BOXES], "cdr", stamps, boxes)
+    builder = FrameBuilder(BagOptions(rate=10_000.0), "far")
+    with pytest.raises(UserError, match=r"^--rate 10000: box stamps from .* make 10000000000000 frames \(a trace"):
+        builder.run([[segment]])

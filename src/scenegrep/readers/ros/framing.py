@@ -55,7 +55,7 @@ from ...model import BoxTable, ImageLayer, LabelTrace, ObjectTable, SampleTable,
 from ...model.geometry import heading_from_atan2, heading_from_yaw
 from ...model.images import concatenate_layers
 from ...model.states import FLOAT_COLUMNS, order_keys
-from ...model.trace import EGO_SIZE_UNKNOWN
+from ...model.trace import EGO_SIZE_UNKNOWN, MAX_FRAMES
 from .decoders import BOX_TYPES, LINK_TYPES, type_key
 from .messages import Boxes, Coded, ImageBoxes, RawMessage
 from .options import BagOptions
@@ -280,7 +280,15 @@ class FrameBuilder:
             )
         else:
             last = self.origin + (self.newest - self.origin) // period * period - period
-        return np.arange(first, last + 1, period, dtype=np.int64) if last >= first else np.empty(0, np.int64)
+        if last < first:
+            return np.empty(0, np.int64)
+        count = (last - first) // period + 1
+        if count > MAX_FRAMES:  # (a stamp far from the others: no array sized by it)
+            raise UserError(
+                f"--rate {self.options.rate:g}: box stamps from {first} to {last} ns make {count} frames "
+                f"(a trace has 0 to {MAX_FRAMES})"
+            )
+        return np.arange(first, last + 1, period, dtype=np.int64)
 
     def _messages(self, stamps: np.ndarray) -> list[tuple[_Segment, np.ndarray, np.ndarray]]:
         """For frames at ``stamps``: per segment (by topic), the messages each frame takes and their frames."""

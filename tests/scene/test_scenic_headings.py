@@ -1,6 +1,6 @@
 """Scenic's road direction at points (:meth:`~scenegrep.scene.geometry.MapGeometry.scenic_headings`)
 and its containment lookups, on Town01 and Town06, against plain references: the R-tree's own predicate for
-the prepared-polygon lookup (:func:`scenegrep.scene.geometry._containing`), and a point-by-point
+the prepared-polygon lookup (:func:`scenegrep.model.roadmap.tree_containing`), and a point-by-point
 reading of Scenic's rules (the first intersection area holding the point and there the first of
 its lanes holding it, else the nearest; else the first lane; off the lanes the first shoulder,
 then within 5 cm an intersection area, the nearest lane, a shoulder; else 0) at random points
@@ -14,7 +14,8 @@ import pytest
 import shapely
 
 from scenegrep.readers.opendrive import read_map
-from scenegrep.scene.geometry import ELEMENT_REACH_M, _containing, geometry_of
+from scenegrep.model.roadmap import tree_containing
+from scenegrep.scene.geometry import ELEMENT_REACH_M, geometry_of
 from tests.scene.test_follow import FIELD
 from tests.scene.test_follow_holders import boundary_points
 
@@ -51,7 +52,7 @@ def test_prepared_containment_finds_what_the_tree_predicate_finds(town):
     shapes = shapely.points(points)
     trees = [geometry.map._lane_tree, geometry._intersection_areas[0], geometry._shoulders[0]]
     for tree in trees:
-        found = sorted(zip(*(a.tolist() for a in _containing(tree, shapes))))
+        found = sorted(zip(*(a.tolist() for a in tree_containing(tree, shapes))))
         expected = sorted(zip(*(a.tolist() for a in tree.query(shapes, predicate="intersects"))))
         assert found == expected
         assert found

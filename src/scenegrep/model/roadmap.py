@@ -190,7 +190,7 @@ class RoadMap:
         points = shapely.points(np.atleast_1d(x), np.atleast_1d(y))
         if not self.lanes:
             return np.zeros(0, np.intp), np.zeros(0, np.intp)
-        point_idx, lane_idx = self._lane_tree.query(points, predicate="intersects")
+        point_idx, lane_idx = tree_containing(self._lane_tree, points)
         order = np.lexsort((lane_idx, point_idx))
         return point_idx[order], lane_idx[order]
 
@@ -329,6 +329,16 @@ class RoadMap:
             self.unknown_layers,
             stop_lines,
         )
+
+
+def tree_containing(tree: STRtree, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(point, geometry) pairs where the tree's geometry intersects the point (shapely points),
+    as ``tree.query(points, predicate="intersects")`` finds them: the R-tree's box candidates
+    tested against the tree's geometries, prepared by its builder (the tree's own predicate
+    prepares the points instead, and tests each polygon's every edge)."""
+    point, found = tree.query(points)
+    hit = shapely.intersects(tree.geometries[found], points[point])
+    return point[hit], found[hit]
 
 
 def _same_element(a: Lane | Area, b: Lane | Area) -> bool:

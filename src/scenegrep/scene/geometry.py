@@ -41,6 +41,7 @@ from ..model import RoadMap
 from ..model.geometry import box_corners
 from ..model.layers import UnknownLayers
 from ..model.polylines import Polylines
+from ..model.roadmap import tree_containing
 from . import shapes
 from .regions import (
     ELEMENT_FIELDS,
@@ -507,7 +508,7 @@ class MapGeometry:
         if len(x):
             inside = np.zeros(0, np.int64)
             if len(road_map.lanes):
-                rows, lanes = _containing(road_map._lane_tree, points)
+                rows, lanes = tree_containing(road_map._lane_tree, points)
                 inside = np.sort(rows * np.int64(len(road_map.lanes)) + lanes)
                 rows, lanes = _first_per_point(rows, lanes)
                 lane[rows] = lanes
@@ -542,7 +543,7 @@ class MapGeometry:
         points = shapely.points(x, y) if points is None else points
         shoulders = self._shoulders
         if shoulders is not None:
-            point, shoulder = _first_per_point(*_containing(shoulders[0], points))
+            point, shoulder = _first_per_point(*tree_containing(shoulders[0], points))
             chosen[point] = shoulders[1].direction_at(shoulder, x[point], y[point])
             elsewhere = np.ones(len(x), dtype=bool)
             elsewhere[point] = False
@@ -582,7 +583,7 @@ class MapGeometry:
         if reach > 0:
             point, area = tree.query(points, predicate="dwithin", distance=reach)
         else:
-            point, area = _containing(tree, points)
+            point, area = tree_containing(tree, points)
         if not len(point):
             return
         point, area = _first_per_point(point, area)
@@ -680,16 +681,6 @@ def _firsts(rows: np.ndarray) -> np.ndarray:
     first = np.ones(len(rows), dtype=bool)
     first[1:] = rows[1:] != rows[:-1]
     return first
-
-
-def _containing(tree: STRtree, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(point, geometry) pairs where the tree's geometry intersects the point (shapely points),
-    as ``tree.query(points, predicate="intersects")`` finds them: the R-tree's box candidates
-    tested against the tree's geometries, prepared by its builder (the tree's own predicate
-    prepares the points instead, and tests each polygon's every edge)."""
-    point, found = tree.query(points)
-    hit = shapely.intersects(tree.geometries[found], points[point])
-    return point[hit], found[hit]
 
 
 def _first_per_point(point: np.ndarray, area: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

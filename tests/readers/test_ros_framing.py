@@ -179,3 +179,28 @@ def test_rate_frames_spanning_more_than_a_trace_holds_are_a_user_error():
     builder = FrameBuilder(BagOptions(rate=10_000.0), "far")
     with pytest.raises(UserError, match=r"^--rate 10000: box stamps from .* make 10000000000000 frames \(a trace"):
         builder.run([[segment]])
+
+
+def test_an_ego_whose_transforms_arrive_after_the_first_frames_is_the_traces_ego():
+    """Frames emitted before the ego's /tf chain is known have no ego row; the ego's rows of the
+    later frames still make it the trace's ego, offline and for the online chunks joined (was:
+    the first emitted frames' answer, None)."""
+    frames = [([("a", "car", "map", (float(f), 0.0, 0.0), 0.0, (4.0, 2.0, 1.5), (1.0, 0.0))], (0.0, 0.0, 0.0), 0.0)
+              for f in range(6)]  # fmt: skip
+    messages = [RawMessage(BOXES, SCHEMAS[BOXES], "ros2msg", b"", "cdr", ORIGIN + f * STEP, b"") for f in range(3)]
+    messages += [
+        RawMessage(topic, SCHEMAS[topic], "ros2msg", b"", "cdr", ORIGIN + f * STEP, b"")
+        for f in range(3, 6)
+        for topic in (TF, BOXES)
+    ]
+    batches = [messages[:3], messages[3:]]
+    trace = FrameBuilder(BagOptions(), "late").run([_segments(b, frames, True) for b in batches])
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(framing, "segments", lambda batch, options: _segments(batch, frames, True))
+        builder = FrameBuilder(BagOptions(), "late")
+        chunks = [c for batch in batches if (c := builder.feed(batch)) is not None]
+        chunks += [last] if (last := builder.finish()) is not None else []
+    assert chunks[0].ego is None and concatenate(chunks).equals(trace)
+    ego_rows = trace.states.frame[trace.states.object == trace.objects.id.tolist().index("ego")]
+    assert trace.n_frames == 6 and 0 < len(ego_rows) < 6
+    assert trace.ego == "ego"

@@ -326,7 +326,8 @@ def _optional_equal(a: Any, b: Any) -> bool:
 
 def concatenate(traces: list[LabelTrace]) -> LabelTrace:
     """The frames of ``traces`` one after the other (e.g. chunks of a stream); objects with the same
-    id are the same object. Name, ego, attributes and map come from the first trace; behaviour
+    id are the same object. Name, attributes and map come from the first trace, the ego from the
+    first trace that has one (a stream's chunks before its ego appears have none); behaviour
     labels are kept if every trace has them; image layers are joined (:func:`concatenate_layers`)."""
     ids: dict[str, int] = {}
     categories: list[str] = []
@@ -365,7 +366,7 @@ def concatenate(traces: list[LabelTrace]) -> LabelTrace:
         lane_ids=tuple(lanes),
         behaviours=behaviours,
         images=concatenate_layers(image_parts),
-        ego=first.ego,
+        ego=next((t.ego for t in traces if t.ego is not None), None),
         attributes=first.attributes,
         source=first.source,
         map_source=first.map_source,

@@ -151,7 +151,7 @@ class _Rows:
         self.category: list[int] = []
         self.times: list[np.ndarray] = []
         self.images: list[tuple[ImageLayer | None, int]] = []
-        self.has_ego: bool | None = None
+        self.has_ego = False
 
     def numbers(self, codes: int) -> np.ndarray:
         """``number``, grown to hold ``codes`` builder codes."""
@@ -427,7 +427,7 @@ class FrameBuilder:
         out.images.append((images, out.frames))
         out.times.append((stamps - self.origin) / 1e9)
         out.frames += len(stamps)
-        out.has_ego = has_ego if out.has_ego is None else out.has_ego
+        out.has_ego = out.has_ego or has_ego  # (frames emitted before the ego's chain was known have no ego row)
 
     def _placement(
         self, frame: np.ndarray, ids: np.ndarray, classes: list[np.ndarray], objects: list[np.ndarray], out: _Rows
